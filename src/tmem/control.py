@@ -1,0 +1,91 @@
+"""Modal controller of the agent: roots (5) and gains (4).
+
+The gains ``K`` are chosen so that one agent interacting with a neighbour held
+still, whose input is then ``U = -K x + const`` (see :mod:`tmem.interaction`),
+has the closed loop ``A - B K`` with the roots (5)::
+
+    p = (-r_l - i im_l, -r_l + i im_l, -i im_r, +i im_r)
+
+The fast, damped left pair belongs to the tilt; the undamped right pair makes
+an encounter lossless, like an elastic collision: speeds are exchanged and the
+RMS velocity of the swarm (its "temperature") is kept.
+
+Formula (4) as printed in the paper does not place these roots (see
+:func:`printed_gains`).  :func:`modal_gains` matches the characteristic
+polynomial of ``A - B K`` with that of the roots instead; the derivation is in
+``docs/equations.md``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def roots(r_l: float, im_l: float, im_r: float) -> np.ndarray:
+    """The desired closed-loop roots (5), ``(-r_l -+ i im_l, -+ i im_r)``."""
+    return np.array([-r_l - 1j * im_l, -r_l + 1j * im_l, -1j * im_r, 1j * im_r])
+
+
+def modal_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r: float) -> np.ndarray:
+    """Gains ``K = (K_P, K_V, K_phi, K_omega)`` placing the roots (5), corrected (4).
+
+    With ``beta = 1 / (kp kd)`` and the state order ``(P, V, phi, omega)``::
+
+        K_P     = beta (r_l^2 + im_l^2) im_r^2 / g
+        K_V     = 2 beta r_l im_r^2 / g
+        K_phi   = beta (r_l^2 + im_l^2 + im_r^2) - 1
+        K_omega = beta (2 r_l - kd)
+
+    These follow from equating ``det(sI - A + B K)`` with
+    ``(s^2 + 2 r_l s + r_l^2 + im_l^2)(s^2 + im_r^2)``.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+    """
+    beta = 1.0 / (kp * kd)
+    left = r_l**2 + im_l**2
+    return np.array(
+        [
+            beta * left * im_r**2 / g,
+            2.0 * beta * r_l * im_r**2 / g,
+            beta * (left + im_r**2) - 1.0,
+            beta * (2.0 * r_l - kd),
+        ]
+    )
+
+
+def printed_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r: float) -> np.ndarray:
+    """Formula (4) exactly as printed in the paper, for comparison only.
+
+    Taken literally with Table 1, ``eig(A - B K)`` is about
+    ``{-11.93 +- 12.19i, -0.074 +- 0.140i}``, not the roots (5).  Its first
+    two entries are the position and velocity gains swapped (the printed first
+    entry is ``K_V``, the second ``K_P``), and the third lacks the ``- 1``:
+    ``K_phi`` comes out as 0.962 instead of -0.038.  Do not use these gains to
+    simulate; use :func:`modal_gains`.
+    """
+    p1, p2, p3, p4 = roots(r_l, im_l, im_r)
+    beta = 1.0 / (kp * kd)
+    k = np.array(
+        [
+            -beta / g * (p1 * p2 * p3 + p1 * p2 * p4 + p1 * p3 * p4 + p2 * p3 * p4),
+            beta / g * p1 * p2 * p3 * p4,
+            beta * (p2 * p3 + p2 * p4 + p3 * p4 + p1 * (p2 + p3 + p4)),
+            -beta * (kd + p1 + p2 + p3 + p4),
+        ]
+    )
+    return k.real
+
+
+def interaction_point(x: np.ndarray, gains: np.ndarray) -> np.ndarray:
+    """The agent's position corrected by its motion state, ``P* = x . K / K_P`` (6).
+
+    Parameters
+    ----------
+    x : ndarray, shape (..., 4)
+        States ``(P, V, phi, omega)``.
+    gains : ndarray, shape (4,)
+        ``K`` from :func:`modal_gains`; ``K_P = gains[0]`` is the paper's ``K1``.
+    """
+    return x @ (gains / gains[0])

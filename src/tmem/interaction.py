@@ -1,0 +1,122 @@
+"""Interaction functions of a pair of agents: (8), Fig. 3, (10) and (11).
+
+Each function takes the paper's pair measure ``d = P*_j - P*_i`` (m), the
+difference of the neighbour's and the agent's corrected positions (6), and
+returns the agent's tilt set-point contribution ``U`` (rad), saturated at
+``|U| <= c_max``.  Negative ``U`` for positive ``d`` pushes the agent away from
+its neighbour; the neighbour gets ``-U`` (the functions are odd in ``d``).
+In 2-D and 3-D the same functions are evaluated at ``|d|`` and act along
+``d / |d|``.
+
+Notation, with ``reach = R + R_j``::
+
+    s_d = sign(d),  c = d - s_d reach   (7),   b = (d_t + reach) / 2
+
+* repulsion (8):      K_P c inside the spheres, 0 outside.
+* attraction (Fig. 3): K_P (d - s_d d_t) inside the spheres, 0 outside:
+  pushes apart closer than d_t, pulls together farther than d_t.
+* switching (10):     f1 = repulsion (8) while the pair is uncoupled
+  (``f_en = 0``); f2 = K_P (d - s_d d_t) at any distance while coupled.
+* improved (11):      f1 = 0 outside, K_P c on (b, reach), -K_P (d - s_d d_t)
+  on [d_t, b], K_P (d - s_d d_t) closer than d_t; f2 as in (10).  f1 is
+  continuous, and f1 = f2 for ``|d| <= d_t``, so coupling at ``|d| = d_t``
+  causes no jump in control.
+
+The paper writes the saturation as ``max(s_d C_max, .)``; it is read here as
+``|U| <= c_max`` with the sign set by the function.
+
+``K_P`` is the modal gain on position (the paper's ``K1``).  All functions are
+NumPy ufuncs compiled by Numba: they broadcast over arrays and are called
+unchanged, one pair at a time, by the compiled step loop.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+#: Interaction function names, in the order of their integer codes.
+FUNCTIONS = ("repulsion", "attraction", "switching", "improved")
+REPULSION, ATTRACTION, SWITCHING, IMPROVED = range(4)
+
+
+def uses_coupling(function: str) -> bool:
+    """True for the functions that switch on the pair flag ``F_en``."""
+    return FUNCTIONS.index(function) >= SWITCHING
+
+
+@numba.njit(cache=True, inline="always")
+def _saturate(u: float, c_max: float) -> float:
+    return min(max(u, -c_max), c_max)
+
+
+@numba.njit(cache=True, inline="always")
+def _sign(d: float) -> float:
+    return (d > 0.0) - (d < 0.0)
+
+
+@numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)
+def repulsion(d, k_p, reach, c_max):
+    """Repulsion (8): ``K_P (d - s_d reach)`` for ``|d| < reach``, else 0; saturated."""
+    if abs(d) >= reach:
+        return 0.0
+    return _saturate(k_p * (d - _sign(d) * reach), c_max)
+
+
+@numba.vectorize(["float64(float64, float64, float64, float64, float64)"], cache=True)
+def attraction(d, k_p, reach, d_t, c_max):
+    """Attraction (Fig. 3): ``K_P (d - s_d d_t)`` for ``|d| < reach``, else 0; saturated."""
+    if abs(d) >= reach:
+        return 0.0
+    return _saturate(k_p * (d - _sign(d) * d_t), c_max)
+
+
+@numba.vectorize(["float64(float64, int64, float64, float64, float64, float64)"], cache=True)
+def switching(d, f_en, k_p, reach, d_t, c_max):
+    """Switching (10): repulsion (8) if ``f_en == 0``, else ``K_P (d - s_d d_t)``; saturated."""
+    if f_en == 0:
+        if abs(d) >= reach:
+            return 0.0
+        return _saturate(k_p * (d - _sign(d) * reach), c_max)
+    return _saturate(k_p * (d - _sign(d) * d_t), c_max)
+
+
+@numba.vectorize(["float64(float64, int64, float64, float64, float64, float64)"], cache=True)
+def improved_switching(d, f_en, k_p, reach, d_t, c_max):
+    """Improved switching (11): the continuous f1 if ``f_en == 0``, else f2; saturated."""
+    r = abs(d)
+    s = _sign(d)
+    if f_en != 0 or r < d_t:
+        u = k_p * (d - s * d_t)
+    elif r >= reach:
+        u = 0.0
+    elif r <= 0.5 * (d_t + reach):
+        u = -k_p * (d - s * d_t)
+    else:
+        u = k_p * (d - s * reach)
+    return _saturate(u, c_max)
+
+
+@numba.njit(cache=True)
+def pair_control(function, d, f_en, k_p, reach, d_t, c_max):
+    """Dispatch to the function with integer code ``function`` (see :data:`FUNCTIONS`)."""
+    if function == REPULSION:
+        return repulsion(d, k_p, reach, c_max)
+    if function == ATTRACTION:
+        return attraction(d, k_p, reach, d_t, c_max)
+    if function == SWITCHING:
+        return switching(d, f_en, k_p, reach, d_t, c_max)
+    return improved_switching(d, f_en, k_p, reach, d_t, c_max)
+
+
+def evaluate(function: str, d, f_en=0, *, k_p: float, reach: float, d_t: float, c_max: float) -> np.ndarray:
+    """Evaluate the named interaction function on an array of pair measures ``d``."""
+    code = FUNCTIONS.index(function)
+    d = np.asarray(d, dtype=float)
+    if code == REPULSION:
+        return repulsion(d, k_p, reach, c_max)
+    if code == ATTRACTION:
+        return attraction(d, k_p, reach, d_t, c_max)
+    if code == SWITCHING:
+        return switching(d, np.asarray(f_en, dtype=np.int64), k_p, reach, d_t, c_max)
+    return improved_switching(d, np.asarray(f_en, dtype=np.int64), k_p, reach, d_t, c_max)
