@@ -1,0 +1,116 @@
+"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``.
+
+User mistakes (a bad scenario, an unusable output directory) end with one
+line on standard error naming the field and the reason, exit status 2 and no
+output written.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from .engine import simulate
+from .io import OutputError, check_output_directory, write_run
+from .scenario import ScenarioError, load
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__.split("\n")[0])
+console = Console(stderr=True)
+
+#: Runs expected to take less than this (s) show no progress bar.
+PROGRESS_AFTER = 1.0
+
+
+class _LazyProgress:
+    """A progress bar that appears only once a run has taken ``PROGRESS_AFTER`` seconds."""
+
+    def __init__(self) -> None:
+        self.started = time.perf_counter()
+        self.bar: Progress | None = None
+        self.tasks: dict[str, int] = {}
+
+    def __call__(self, label: str, done: int, total: int) -> None:
+        if self.bar is None:
+            if time.perf_counter() - self.started < PROGRESS_AFTER or not console.is_terminal:
+                return
+            self.bar = Progress(
+                TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                TimeRemainingColumn(), console=console, transient=True,
+            )  # fmt: skip
+            self.bar.start()
+        if label not in self.tasks:
+            self.tasks[label] = self.bar.add_task(label, total=total)
+        self.bar.update(self.tasks[label], completed=done)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def _fail(message: str) -> None:
+    console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    raise typer.Exit(2)
+
+
+def _summary_table(rows: dict[str, dict]) -> Table:
+    table = Table("run", "function", "coupled", "couple t, s", "uncouple t, s", "RMS change, %", "min dist, m")
+    for name, s in rows.items():
+        fmt = lambda v: "—" if v is None else f"{v:.2f}"  # noqa: E731
+        table.add_row(
+            name, s["function"], "yes" if s["coupled"] else "no", fmt(s["couple_time"]),
+            fmt(s["uncouple_time"]), f"{s['rms_change_percent']:+.3f}", f"{s['min_distance']:.2f}",
+        )  # fmt: skip
+    return table
+
+
+@app.command()
+def run(
+    scenario: Path = typer.Argument(..., help="Scenario TOML file (see examples/)."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output directory (replaced if it holds an earlier run)."),
+) -> None:
+    """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT."""
+    progress = _LazyProgress()
+    try:
+        loaded = load(scenario)
+        check_output_directory(out)
+        trajectory = simulate(loaded, progress=lambda done, total: progress(scenario.name, done, total))
+        progress.close()
+        summary = write_run(trajectory, out)
+    except (ScenarioError, OutputError) as exc:
+        progress.close()
+        _fail(str(exc))
+    Console().print(_summary_table({loaded.name or scenario.stem: summary}))
+    Console().print(f"written to {out}/")
+
+
+@app.command()
+def paper(
+    out: Path = typer.Option(Path("out/paper"), "--out", "-o", help="Output directory."),
+) -> None:
+    """Reproduce the paper's Figs. 5, 7 and 9 into OUT/fig5, OUT/fig7, OUT/fig9 and OUT/report.md."""
+    from .paper import run_paper
+
+    progress = _LazyProgress()
+    try:
+        summaries, _ = run_paper(out, progress=progress)
+    except OutputError as exc:
+        progress.close()
+        _fail(str(exc))
+    progress.close()
+    Console().print(_summary_table(summaries))
+    Console().print(f"report: {out / 'report.md'}")
+
+
+def main() -> None:
+    """Entry point of the ``tmem`` console script."""
+    try:
+        app()
+    except KeyboardInterrupt:
+        console.print("interrupted; no output was written")
+        sys.exit(130)

@@ -1,0 +1,145 @@
+"""Run outputs: the trajectory as an xarray dataset, and run directories.
+
+A run directory holds ``summary.json`` (:func:`tmem.metrics.summarize`),
+``trajectory.nc`` (:func:`to_dataset`, NetCDF-4 via h5netcdf) and the figures
+of :mod:`tmem.plot`.  Directories are written next to their destination under
+a temporary name and moved into place only when complete, so an interrupted
+or failed run leaves no half-written output and never touches an older one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import __version__, metrics, plot
+from .engine import Trajectory
+from .model import STATE_NAMES
+
+PAPER = "E. Heiss, A. Kozyr, O. Morozov, Formations Organization in Robotic Swarm Using the Thermal Motion Equivalent Method"
+
+_STATE_ATTRS = {
+    "P": ("position", "m"),
+    "V": ("velocity", "m s-1"),
+    "phi": ("tilt from the vertical", "rad"),
+    "omega": ("tilt rate", "rad s-1"),
+}
+#: Files that mark a directory as tmem output, which a new run may replace.
+_OUTPUT_MARKERS = ("summary.json", "report.md")
+
+
+class OutputError(ValueError):
+    """An output directory that cannot be written; the message is one line."""
+
+
+def to_dataset(trajectory: Trajectory) -> xr.Dataset:
+    """The recorded trajectory as an :class:`xarray.Dataset`.
+
+    Dimensions ``time``, ``agent``, ``axis`` and ``pair``; variables ``P``,
+    ``V``, ``phi``, ``omega`` and the control ``U`` over (time, agent, axis);
+    the coupling flag ``F_en``, the distance and the interaction distance
+    ``|d|`` (6) over (time, pair); the RMS velocity over time.  Units are in
+    each variable's attributes; the scenario (as TOML), the gains and the
+    events are in the dataset's attributes.
+    """
+    n_axes = trajectory.state.shape[2]
+    coords = {
+        "time": ("time", trajectory.time, {"units": "s"}),
+        "agent": np.arange(trajectory.state.shape[1]),
+        "axis": ["x", "y", "z"][:n_axes],
+        "pair": np.arange(len(trajectory.pairs)),
+        "pair_i": ("pair", trajectory.pairs[:, 0], {"long_name": "first agent of the pair"}),
+        "pair_j": ("pair", trajectory.pairs[:, 1], {"long_name": "second agent of the pair"}),
+    }
+    data = {}
+    for m, name in enumerate(STATE_NAMES):
+        long_name, units = _STATE_ATTRS[name]
+        data[name] = (("time", "agent", "axis"), trajectory.state[..., m], {"long_name": long_name, "units": units})
+    data["U"] = (
+        ("time", "agent", "axis"),
+        trajectory.control,
+        {"long_name": "tilt set-point (control)", "units": "rad"},
+    )
+    data["F_en"] = (
+        ("time", "pair"),
+        trajectory.flag.astype(np.int8),
+        {"long_name": "pair coupling flag F_en", "units": "1"},
+    )
+    data["distance"] = (
+        ("time", "pair"),
+        metrics.distance(trajectory),
+        {"long_name": "distance |P_j - P_i|", "units": "m"},
+    )
+    data["interaction_distance"] = (
+        ("time", "pair"),
+        metrics.interaction_distance(trajectory),
+        {"long_name": "interaction distance |P*_j - P*_i|, (6)", "units": "m"},
+    )
+    data["rms_velocity"] = (
+        ("time",),
+        metrics.rms_velocity(trajectory.state[..., 1]),
+        {"long_name": "RMS velocity over agents", "units": "m s-1"},
+    )
+    summary_events = metrics.summarize_events(trajectory.events)
+    attrs = {
+        "title": f"tmem run {trajectory.scenario.name}".strip(),
+        "source": f"tmem {__version__}",
+        "references": PAPER,
+        "scenario": trajectory.scenario.to_toml(),
+        "gains": trajectory.gains,
+        "gains_order": "K_P K_V K_phi K_omega",
+        "events": json.dumps(summary_events),
+    }
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def check_output_directory(out: str | Path) -> Path:
+    """Refuse an ``out`` that exists and is not empty or an earlier tmem output."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"--out {out}: exists and is not a directory")
+    if out.is_dir() and any(out.iterdir()) and not any((out / m).exists() for m in _OUTPUT_MARKERS):
+        raise OutputError(f"--out {out}: directory is not empty and holds no tmem output; choose another")
+    return out
+
+
+@contextmanager
+def atomic_directory(out: str | Path) -> Iterator[Path]:
+    """Yield a temporary directory that replaces ``out`` only if the block succeeds."""
+    out = check_output_directory(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    umask = os.umask(0)
+    os.umask(umask)
+    tmp.chmod(0o777 & ~umask)  # mkdtemp made it private
+    if out.exists():
+        shutil.rmtree(out)
+    tmp.rename(out)
+
+
+def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
+    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``."""
+    summary = metrics.summarize(trajectory)
+    (directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    to_dataset(trajectory).to_netcdf(directory / "trajectory.nc", engine="h5netcdf")
+    plot.write_figures(trajectory, directory)
+    return summary
+
+
+def write_run(trajectory: Trajectory, out: str | Path) -> dict:
+    """Write a complete run directory at ``out`` (atomically) and return its summary."""
+    with atomic_directory(out) as tmp:
+        return write_run_files(trajectory, tmp)
