@@ -14,7 +14,7 @@ import math
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
@@ -51,7 +51,7 @@ class ControllerParams(_Strict):
     @classmethod
     def _stable_left_pair(cls, v: float) -> float:
         if v <= 0:
-            raise ValueError(f"must be > 0 so that the left pair of roots -r_l +- i im_l is stable, got {v}")
+            raise ValueError("must be > 0 so that the left pair of roots -r_l +- i im_l is stable")
         return v
 
 
@@ -171,13 +171,15 @@ def _explain(error: dict) -> str:
         reason = "is required"
     elif kind == "finite_number":
         reason = f"must be a finite number, got {error['input']}"
+    elif kind == "too_short":
+        reason = f"needs at least {error['ctx']['min_length']} entries, got {error['ctx']['actual_length']}"
     else:
         ctx_error = error.get("ctx", {}).get("error")
         if isinstance(ctx_error, _FieldError):
             where = f"{where}.{ctx_error.field}" if where else ctx_error.field
             reason = ctx_error.reason
         else:
-            reason = error["msg"].removeprefix("Value error, ")
+            reason = error["msg"].removeprefix("Value error, ").replace("Input should be", "must be")
             if "input" in error and not isinstance(error["input"], dict | list):
                 reason += f", got {error['input']!r}"
     return f"{where}: {reason}" if where else reason
@@ -215,6 +217,27 @@ def loads(text: str, source: str = "<scenario>") -> Scenario:
         return from_dict(data)
     except ScenarioError as exc:
         raise ScenarioError(f"{source}: {exc}") from None
+
+
+def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
+    """A copy of ``scenario`` with values replaced by dotted path, validated again.
+
+    Example: ``with_changes(s, {"interaction.function": "repulsion", "agents[1].velocity": 2.0})``.
+    A whole list can be replaced too: ``{"agents": [{"position": 0.0}, {"position": 50.0}]}``.
+    """
+    data = scenario.model_dump()
+    for path, value in changes.items():
+        parts = [int(p) if p.isdigit() else p for p in path.replace("[", ".").replace("]", "").split(".")]
+        node = data
+        try:
+            for part in parts[:-1]:
+                node = node[part]
+            if isinstance(node, dict) and parts[-1] not in node:
+                raise KeyError(parts[-1])
+            node[parts[-1]] = value
+        except (KeyError, IndexError, TypeError):
+            raise ScenarioError(f"{path}: unknown parameter path") from None
+    return from_dict(data)
 
 
 def preset(name: str) -> Scenario:
@@ -264,4 +287,5 @@ __all__ = [
     "load",
     "loads",
     "preset",
+    "with_changes",
 ]

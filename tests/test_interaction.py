@@ -1,0 +1,117 @@
+"""Interaction functions (8), Fig. 3, (10), (11) against the paper's formulas written out literally."""
+
+import numpy as np
+import pytest
+
+from tmem import interaction
+
+K_P, REACH, D_T, C_MAX = 0.0296347, 40.0, 35.0, 0.1
+PARAMS = dict(k_p=K_P, reach=REACH, d_t=D_T, c_max=C_MAX)
+B = (D_T + REACH) / 2
+
+
+def sat(u):
+    return max(-C_MAX, min(C_MAX, u))
+
+
+def paper(function, d, f_en):
+    """A slow literal transcription of the paper, with c_j of (7) and d_j = c_j + s_d (R + R_j)."""
+    s = float(np.sign(d))
+    c = d - s * REACH  # (7)
+    d_j = c + s * REACH
+    if function == "repulsion" or (function == "switching" and f_en == 0):  # (8), f1 of (10)
+        return sat(K_P * c) if abs(d_j) < REACH else 0.0
+    if function == "attraction":  # Fig. 3
+        return sat(K_P * (d_j - s * D_T)) if abs(d_j) < REACH else 0.0
+    if f_en == 1:  # f2 of (10) and (11)
+        return sat(K_P * (d_j - s * D_T))
+    if abs(d_j) >= REACH:  # f1 of (11)
+        return 0.0
+    if B < abs(d_j):
+        return sat(K_P * c)
+    if D_T <= abs(d_j):
+        return sat(-K_P * (d_j - s * D_T))
+    return sat(K_P * (d_j - s * D_T))
+
+
+BREAKPOINTS = [0.0, 1e-9, 3.0, D_T - 1e-9, D_T, D_T + 1e-9, B - 1e-9, B, B + 1e-9, REACH - 1e-9, REACH, REACH + 1e-9, 60.0]
+GRID = np.concatenate([np.linspace(-70, 70, 2801), BREAKPOINTS, [-x for x in BREAKPOINTS]])
+CASES = [("repulsion", 0), ("attraction", 0), ("switching", 0), ("switching", 1), ("improved", 0), ("improved", 1)]
+
+
+@pytest.mark.parametrize("function,f_en", CASES)
+def test_matches_literal_transcription_everywhere(function, f_en):
+    ours = interaction.evaluate(function, GRID, f_en, **PARAMS)
+    ref = np.array([paper(function, d, f_en) for d in GRID])
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("function,f_en", CASES)
+def test_odd_in_d_and_saturated(function, f_en):
+    u = interaction.evaluate(function, GRID, f_en, **PARAMS)
+    u_mirror = interaction.evaluate(function, -GRID, f_en, **PARAMS)
+    np.testing.assert_array_equal(u, -u_mirror)
+    assert np.all(np.abs(u) <= C_MAX)
+
+
+def test_repulsion_pushes_apart_inside_and_is_zero_outside():
+    u = interaction.repulsion(np.array([10.0, 39.0, 40.0, 41.0]), K_P, REACH, C_MAX)
+    assert u[0] == -C_MAX  # saturated
+    assert u[1] == pytest.approx(-K_P * 1.0)  # linear part K_P c
+    assert u[2] == 0.0 and u[3] == 0.0  # |d| = R + R_j is outside
+
+
+def test_attraction_pulls_beyond_d_t_and_pushes_inside():
+    u = interaction.attraction(np.array([30.0, 35.0, 36.0, 39.0, 40.0]), K_P, REACH, D_T, C_MAX)
+    assert u[0] < 0 and u[1] == 0.0 and u[2] > 0 and u[3] == C_MAX and u[4] == 0.0
+
+
+def test_improved_f1_is_continuous_at_b_and_d_t():
+    f1 = lambda d: interaction.improved_switching(d, 0, K_P, REACH, D_T, C_MAX)  # noqa: E731
+    for point in (B, D_T):
+        for h in (1e-6, 1e-9):
+            assert abs(f1(point - h) - f1(point + h)) < 2 * K_P * h + 1e-15
+    assert f1(B) == pytest.approx(-K_P * (REACH - B))  # the repulsive peak of the tent
+    assert f1(D_T) == 0.0
+
+
+def test_improved_f1_equals_f2_inside_d_t():
+    d = np.linspace(-D_T, D_T, 1001)
+    f1 = interaction.improved_switching(d, 0, K_P, REACH, D_T, C_MAX)
+    f2 = interaction.improved_switching(d, 1, K_P, REACH, D_T, C_MAX)
+    np.testing.assert_array_equal(f1, f2)
+
+
+def test_improved_f1_and_f2_differ_between_d_t_and_reach():
+    d = np.linspace(D_T + 0.1, REACH - 0.1, 50)
+    f1 = interaction.improved_switching(d, 0, K_P, REACH, D_T, C_MAX)
+    f2 = interaction.improved_switching(d, 1, K_P, REACH, D_T, C_MAX)
+    assert np.all(f1 < 0) and np.all(f2 > 0)
+
+
+def test_switching_steps_at_the_coupling_point():
+    """(10): at |d| = d_t, f1 is the repulsion, f2 is zero: a jump of min(K_P (reach - d_t), c_max)."""
+    f1 = interaction.switching(D_T, 0, K_P, REACH, D_T, C_MAX)
+    f2 = interaction.switching(D_T, 1, K_P, REACH, D_T, C_MAX)
+    assert f2 == 0.0
+    assert f1 - f2 == pytest.approx(-min(K_P * (REACH - D_T), C_MAX))
+    # Unsaturated, the step is the full K_P (reach - d_t).
+    f1_wide = interaction.switching(D_T, 0, K_P, REACH, D_T, 1.0)
+    assert f1_wide == pytest.approx(-K_P * (REACH - D_T))
+
+
+def test_coupled_attraction_has_no_range_limit():
+    assert interaction.switching(100.0, 1, K_P, REACH, D_T, C_MAX) == C_MAX
+    assert interaction.improved_switching(-100.0, 1, K_P, REACH, D_T, C_MAX) == -C_MAX
+
+
+def test_dispatch_matches_named_functions():
+    for code, name in enumerate(interaction.FUNCTIONS):
+        for d in BREAKPOINTS:
+            for f_en in (0, 1):
+                expected = interaction.evaluate(name, d, f_en, **PARAMS)
+                assert interaction.pair_control(code, d, f_en, K_P, REACH, D_T, C_MAX) == expected
+
+
+def test_uses_coupling():
+    assert [interaction.uses_coupling(f) for f in interaction.FUNCTIONS] == [False, False, True, True]

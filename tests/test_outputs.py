@@ -1,0 +1,100 @@
+"""`tmem run` and `tmem paper` outputs: summary.json, trajectory.nc, figures, report.md."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from typer.testing import CliRunner
+
+import tmem
+from tmem.cli import app
+from tmem.metrics import rms_velocity
+
+EXAMPLES = Path(__file__).parent.parent / "examples"
+REQUIRED = {
+    "rms_velocity_initial", "rms_velocity_final", "rms_change_percent", "min_distance",
+    "final_distance", "coupled", "events", "gains",
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def fig9_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run") / "fig9"
+    result = CliRunner().invoke(app, ["run", str(EXAMPLES / "fig9.toml"), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    return out
+
+
+def test_run_writes_the_promised_files(fig9_run):
+    assert sorted(p.name for p in fig9_run.iterdir()) == [
+        "distance.png", "summary.json", "trajectory.nc", "velocity.png",
+    ]  # fmt: skip
+    for png in ("distance.png", "velocity.png"):
+        assert (fig9_run / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_summary_has_the_promised_keys_and_values(fig9_run):
+    s = json.loads((fig9_run / "summary.json").read_text())
+    assert REQUIRED <= s.keys()
+    assert s["coupled"] is True
+    np.testing.assert_allclose(s["gains"], tmem.modal_gains(6.0, 25.0, 9.8, 12.0, 0.1, 0.55), rtol=1e-15)
+    assert [e["kind"] for e in s["events"]] == ["couple", "command", "uncouple"]
+    for e in s["events"]:
+        assert set(e) >= {"time", "kind", "agents"} and e["agents"] == [0, 1]
+    assert s["rms_change_percent"] == pytest.approx(100 * (s["rms_velocity_final"] / s["rms_velocity_initial"] - 1))
+
+
+def test_dataset_matches_summary_and_carries_units_and_scenario(fig9_run):
+    s = json.loads((fig9_run / "summary.json").read_text())
+    with xr.open_dataset(fig9_run / "trajectory.nc", engine="h5netcdf") as ds:
+        assert dict(ds.sizes) == {"time": 6001, "agent": 2, "axis": 1, "pair": 1}
+        for name in ("P", "V", "phi", "omega", "U"):
+            assert ds[name].dims == ("time", "agent", "axis")
+        assert ds["F_en"].dims == ("time", "pair")
+        units = {name: ds[name].attrs["units"] for name in ("P", "V", "phi", "omega", "U", "distance")}
+        assert units == {"P": "m", "V": "m s-1", "phi": "rad", "omega": "rad s-1", "U": "rad", "distance": "m"}
+        assert ds["time"].attrs["units"] == "s"
+        rms = rms_velocity(ds["V"].values)
+        assert rms[0] == pytest.approx(s["rms_velocity_initial"], rel=1e-15)
+        assert rms[-1] == pytest.approx(s["rms_velocity_final"], rel=1e-15)
+        np.testing.assert_allclose(ds["distance"].values[-1, 0], s["final_distance"], rtol=1e-15)
+        np.testing.assert_allclose(ds.attrs["gains"], s["gains"], rtol=1e-15)
+        # The stored scenario is the one that ran.
+        assert tmem.loads(ds.attrs["scenario"]) == tmem.load(EXAMPLES / "fig9.toml")
+        # The flag is 1 exactly between the couple and uncouple events.
+        coupled = ds["time"].values[ds["F_en"].values[:, 0] == 1]
+        assert coupled.min() == pytest.approx(s["couple_time"], abs=0.01)
+        assert coupled.max() == pytest.approx(s["uncouple_time"], abs=0.01)
+
+
+def test_rerun_replaces_an_earlier_run(tmp_path):
+    out = tmp_path / "o"
+    runner = CliRunner()
+    assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
+    (out / "stale.txt").write_text("from an earlier version")
+    assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
+    assert not (out / "stale.txt").exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["o"]  # no temporary directory left behind
+
+
+def test_paper_command_writes_three_runs_and_the_report(tmp_path):
+    out = tmp_path / "paper"
+    result = CliRunner().invoke(app, ["paper", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == ["fig5", "fig7", "fig9", "report.md"]
+    report = (out / "report.md").read_text()
+    for name in ("fig5", "fig7", "fig9"):
+        s = json.loads((out / name / "summary.json").read_text())
+        assert (out / name / "trajectory.nc").exists()
+        if s["function"] != "attraction":
+            # The report quotes our measured numbers, not numbers of its own.
+            assert f"{s['rms_change_percent']:+.2f} %" in report
+            assert f"F_en drops at {s['uncouple_time']:.2f} s" in report
+    assert "≈ 5.6 %" in report and "≈ 0.2 %" in report
+
+
+@pytest.mark.parametrize("name", tmem.scenario.PRESETS)
+def test_examples_are_the_shipped_presets(name):
+    assert tmem.load(EXAMPLES / f"{name}.toml") == tmem.preset(name)
