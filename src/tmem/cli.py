@@ -59,7 +59,7 @@ def _fail(message: str) -> None:
 
 
 def _summary_table(rows: dict[str, dict]) -> Table:
-    table = Table("run", "function", "coupled", "couple t, s", "uncouple t, s", "RMS change, %", "min dist, m")
+    table = Table("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
     for name, s in rows.items():
         fmt = lambda v: "—" if v is None else f"{v:.2f}"  # noqa: E731
         table.add_row(
