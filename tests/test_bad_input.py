@@ -35,7 +35,7 @@ CASES = {
     "eps negative": (edit("eps = 0.2", "eps = -0.2"), "interaction.eps", "must be greater than 0"),
     "nan": (edit("kp = 6.0", "kp = nan"), "model.kp", "finite"),
     "inf": (edit("position = 50.0", "position = inf"), "agents[0].position", "finite"),
-    "one agent": (without_agent(GOOD), "agents", "needs at least 2 entries, got 1"),
+    "one agent": (without_agent(GOOD), "agents", "needs at least 2 agents, got 1"),
     "unknown function": (edit('function = "improved"', 'function = "magnet"'), "interaction.function", "'repulsion'"),
     "unknown action": (edit('action = "uncouple"', 'action = "explode"'), "commands[0].action", "'couple'"),
     "typo in key": (edit("c_max = 0.1", "cmax = 0.1"), "interaction.cmax", "unknown key"),

@@ -98,7 +98,7 @@ def test_couple_command_rearms_a_released_pair():
     tr = tmem.simulate(s)
     kinds = [e.kind for e in tr.events]
     assert kinds[:4] == ["couple", "command", "uncouple", "command"]
-    assert tr.events[1].agents == (-1, -1)  # a command to every pair
+    assert tr.events[1].agents == ()  # a command to every pair
     # Released at ~d_t and pushed apart, the pair is no longer at d_t when re-armed, so it stays
     # uncoupled unless it comes back to d_t; either way the flag follows the events.
     assert tr.flag[-1, 0] == (1 if kinds[-1] == "couple" else 0)

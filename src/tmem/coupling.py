@@ -29,7 +29,7 @@ EVENT_KINDS = ("command", "couple", "uncouple")
 EVENT_COMMAND, EVENT_COUPLE, EVENT_UNCOUPLE = range(3)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def next_flag(f_en, armed, r, d_t, eps):
     """The pair flag after one check at pair measure ``r = |d|`` (see module text)."""
     if abs(r - d_t) < eps:

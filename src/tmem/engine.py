@@ -1,22 +1,31 @@
 """The step loop: scenario in, recorded trajectory and events out.
 
-State is kept as arrays shaped ``(agents, axes, 4)`` (the paper's case is one
-axis).  Each step ``k`` (time ``k dt``):
+State is kept as arrays shaped ``(agents, axes, 4)``; every axis uses the
+paper's per-axis model (2) with the same gains.  Each step ``k`` (time
+``k dt``):
 
-1. operator commands due at step ``k`` arm or disarm their pairs;
-2. every agent's corrected position ``P*`` (6) is formed;
-3. for every pair, the pair measure ``d = P*_j - P*_i`` updates the flag
-   ``F_en`` (:mod:`tmem.coupling`) and gives the control contribution
-   (:mod:`tmem.interaction`), applied along ``d / |d|`` to ``i`` and opposite
-   to ``j``;
-4. each agent's summed set-point is saturated at ``c_max`` per axis (a single
-   neighbour's contribution is already within it);
-5. the step is recorded if ``k`` is a multiple of ``record_every`` (and always
+1. operator commands due at step ``k`` arm or disarm formation pairs, or
+   remove or add agents;
+2. every agent's corrected position ``P*`` (6) is formed, and the neighbour
+   lists rebuilt if some ``P*`` has moved more than half the skin;
+3. every agent sums the pushes of its non-formation neighbours within
+   ``R + R_j``: the repulsion (8) (or the flagless function of the scenario),
+   ``f(|d|)`` along ``d / |d|`` with ``d = P*_j - P*_i``;
+4. every formation pair (or, in a small swarm without a formation, every
+   pair: :meth:`Scenario.pairs`) updates its flag ``F_en`` (:mod:`tmem.coupling`) and
+   adds its switching function (10) or (11), equal and opposite, to its two
+   agents; while coupled with a required direction ``b``, the pair's pull is
+   the vector spring ``K_P (d - d_t b)`` instead;
+5. each agent's summed set-point is saturated on its norm, ``|U| <= c_max``:
+   a tilt limit that does not depend on how the axes are turned;
+6. the step is recorded if ``k`` is a multiple of ``record_every`` (and always
    at the last step);
-6. the state advances with the exact zero-order hold of (2) over ``dt``.
+7. the state advances with the exact zero-order hold of (2) over ``dt``.
 
-The loop is compiled with Numba and runs in chunks so that a caller can show
-progress between them.
+A removed agent stops where it is, and no longer interacts (a lost
+vehicle); an added agent starts from its ``[[agents]]`` entry.  The loop is
+compiled with Numba (threads over agents for large swarms) and runs in
+chunks, so that a caller can show progress between them.
 """
 
 from __future__ import annotations
@@ -31,18 +40,27 @@ import numpy as np
 from . import coupling, interaction
 from .control import modal_gains
 from .model import state_matrices, zero_order_hold
-from .neighbors import all_pairs
+from .neighbors import all_pairs, nearest_image, verlet_lists
 from .scenario import Scenario
+from .setup import Setup, build
+
+#: Command kinds in the compiled loop.
+UNCOUPLE, COUPLE, REMOVE, ADD = range(4)
+_COMMAND_CODES = {"uncouple": UNCOUPLE, "couple": COUPLE, "remove": REMOVE, "add": ADD}
+#: Swarms at least this large use Verlet lists and threads ("auto").
+LARGE_SWARM = 64
+#: Status returned by the compiled loop when the neighbour lists must be built before step k.
+_LISTS_STALE = -1
 
 
 @dataclass(frozen=True)
 class Event:
-    """A coupling transition or an operator command."""
+    """A coupling transition, or an operator command (``agents`` empty for every pair)."""
 
     time: float
     kind: str  # "command" | "couple" | "uncouple"
-    agents: tuple[int, int]
-    action: str | None = None  # for commands: "couple" | "uncouple"
+    agents: tuple[int, ...]
+    action: str | None = None  # for commands: "couple" | "uncouple" | "remove" | "add"
 
 
 @dataclass(frozen=True)
@@ -52,118 +70,265 @@ class Trajectory:
     Attributes
     ----------
     scenario : Scenario
+    setup : Setup
+        The initial arrays: states, flying agents, pairs with their ``d_t`` and
+        directions, the periodic box.
     gains : ndarray, shape (4,)
         ``K = (K_P, K_V, K_phi, K_omega)``.
     time : ndarray, shape (n_records,)
-    state : ndarray, shape (n_records, agents, axes, 4)
+    agents : ndarray, shape (n_recorded,)
+        Indices of the recorded agents.
+    state : ndarray, shape (n_records, n_recorded, axes, 4)
         ``(P, V, phi, omega)`` at each recorded time.
-    control : ndarray, shape (n_records, agents, axes)
+    control : ndarray, shape (n_records, n_recorded, axes)
         The tilt set-point ``U`` applied from that time on.
-    pairs : ndarray, shape (n_pairs, 2)
+    active : ndarray, shape (n_records, n_recorded), bool
+        Whether each agent was flying.
     flag : ndarray, shape (n_records, n_pairs)
         ``F_en`` of each pair at each recorded time (after that step's check).
+    pair_distance : ndarray, shape (n_records, n_pairs)
+        ``|P_j - P_i|`` of each pair (nearest image).
+    interaction_distance : ndarray, shape (n_records, n_pairs)
+        ``|d| = |P*_j - P*_i|`` (6) of each pair.
     min_distance : ndarray, shape (n_pairs,)
-        Smallest distance ``|P_j - P_i|`` of each pair over every step.
+        Smallest distance of each formation pair over every step.
+    min_neighbor_distance : float
+        Smallest distance between any two agents within ``R + R_j`` of each
+        other (in ``P*``) at any step; ``inf`` if no two came so close.
+    final_state : ndarray, shape (agents, axes, 4)
+        Every agent's state at the end.
+    final_active : ndarray, shape (agents,), bool
     events : list of Event
+    list_builds : int
+        How often the neighbour lists were built.
     """
 
     scenario: Scenario
+    setup: Setup
     gains: np.ndarray
     time: np.ndarray
+    agents: np.ndarray
     state: np.ndarray
     control: np.ndarray
-    pairs: np.ndarray
+    active: np.ndarray
     flag: np.ndarray
+    pair_distance: np.ndarray
+    interaction_distance: np.ndarray
     min_distance: np.ndarray
+    min_neighbor_distance: float
+    final_state: np.ndarray
+    final_active: np.ndarray
     events: list[Event]
+    list_builds: int
+
+    @property
+    def pairs(self) -> np.ndarray:
+        """The pairs handled one by one (:meth:`Scenario.pairs`), shape (n_pairs, 2)."""
+        return self.setup.edges
+
+    @property
+    def d_t(self) -> np.ndarray:
+        """Set distance of each pair, shape (n_pairs,)."""
+        return self.setup.d_t
 
 
-@numba.njit(cache=True)
-def _advance(
+def _advance_source(
     k_start, k_stop, n_steps, record_every,
-    x, ad, bd, gains, function, k_p, reach, d_t, eps, c_max, coupled_function,
-    pairs, armed, flag, min_distance,
-    command_step, command_pair, command_arm, next_command,
-    rec_state, rec_control, rec_flag, next_record,
-    event_step, event_kind, event_pair, event_action, n_events,
+    x, active, x_start, ad, bd, gains, function, couples, pair_function, k_p, reach, eps, c_max, box,
+    use_lists, skin, nbr_ptr, nbr_idx, p_ref,
+    edge_i, edge_j, edge_dt, edge_dir, flag, armed, adj_ptr, adj_idx, edge_min, agent_min,
+    cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
+    rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
+    event_step, event_kind, event_i, event_j, event_action, n_events,
 ):  # fmt: skip
     n_agents, n_axes, _ = x.shape
-    n_pairs = pairs.shape[0]
+    n_edges = edge_i.shape[0]
     p_star = np.empty((n_agents, n_axes))
-    u = np.empty((n_agents, n_axes))
+    u = np.zeros((n_agents, n_axes))
+    moved = np.zeros(n_agents)
     d = np.empty(n_axes)
-    x_new = np.empty(4)
+    v = np.empty(n_axes)
+    reach2 = reach * reach
     for k in range(k_start, k_stop):
         # 1. operator commands
-        while next_command < command_step.shape[0] and command_step[next_command] <= k:
+        rebuild = False
+        while next_command < cmd_step.shape[0] and cmd_step[next_command] <= k:
             c = next_command
-            for p in range(n_pairs):
-                if command_pair[c] < 0 or command_pair[c] == p:
-                    armed[p] = command_arm[c]
+            kind = cmd_kind[c]
+            if kind == REMOVE or kind == ADD:
+                i = cmd_target[cmd_ptr[c]]
+                active[i] = kind == ADD
+                if kind == ADD:
+                    x[i] = x_start[i]
+                    rebuild = True
+                else:
+                    for a in range(n_axes):
+                        x[i, a, 1:] = 0.0  # a lost vehicle: it stops where it is
+                event_i[n_events] = i
+                event_j[n_events] = -1
+            else:
+                if cmd_ptr[c] == cmd_ptr[c + 1]:
+                    armed[:] = 1 if kind == COUPLE else 0
+                for t in range(cmd_ptr[c], cmd_ptr[c + 1]):
+                    armed[cmd_target[t]] = 1 if kind == COUPLE else 0
+                single = cmd_ptr[c + 1] - cmd_ptr[c] == 1
+                event_i[n_events] = edge_i[cmd_target[cmd_ptr[c]]] if single else -1
+                event_j[n_events] = edge_j[cmd_target[cmd_ptr[c]]] if single else -1
             event_step[n_events] = k
             event_kind[n_events] = coupling.EVENT_COMMAND
-            event_pair[n_events] = command_pair[c]
-            event_action[n_events] = command_arm[c]
+            event_action[n_events] = kind
             n_events += 1
             next_command += 1
-        # 2. corrected positions (6)
-        for i in range(n_agents):
+        # 2. corrected positions (6); neighbour lists
+        for i in numba.prange(n_agents):
+            shift2 = 0.0
             for a in range(n_axes):
                 s = 0.0
                 for m in range(4):
                     s += x[i, a, m] * gains[m]
                 p_star[i, a] = s / gains[0]
-                u[i, a] = 0.0
-        # 3. pairs: flag and control
-        for p in range(n_pairs):
-            i = pairs[p, 0]
-            j = pairs[p, 1]
+                delta = nearest_image(p_star[i, a] - p_ref[i, a], box[a])
+                shift2 += delta * delta
+            moved[i] = shift2 if active[i] else 0.0
+        if use_lists and (rebuild or np.sqrt(moved.max()) > 0.5 * skin):
+            # The caller builds the lists (with p_ref = P* now) and resumes at step k.
+            return k, next_command, next_record, n_events, _LISTS_STALE
+        # 3. non-formation neighbours
+        for i in numba.prange(n_agents):
+            u0 = 0.0
+            u1 = 0.0
+            u2 = 0.0
+            if active[i]:
+                for q in range(nbr_ptr[i], nbr_ptr[i + 1]):
+                    j = nbr_idx[q]
+                    if not active[j]:
+                        continue
+                    r2 = 0.0
+                    d0 = nearest_image(p_star[j, 0] - p_star[i, 0], box[0])
+                    r2 = d0 * d0
+                    d1 = 0.0
+                    d2 = 0.0
+                    if n_axes > 1:
+                        d1 = nearest_image(p_star[j, 1] - p_star[i, 1], box[1])
+                        r2 += d1 * d1
+                    if n_axes > 2:
+                        d2 = nearest_image(p_star[j, 2] - p_star[i, 2], box[2])
+                        r2 += d2 * d2
+                    if r2 >= reach2 or r2 == 0.0:
+                        continue
+                    partner = False
+                    for e in range(adj_ptr[i], adj_ptr[i + 1]):
+                        if adj_idx[e] == j:
+                            partner = True
+                    if partner:
+                        continue
+                    dist2 = 0.0
+                    for a in range(n_axes):
+                        delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
+                        dist2 += delta * delta
+                    if dist2 < agent_min[i]:
+                        agent_min[i] = dist2
+                    r = np.sqrt(r2)
+                    push = interaction.pair_control(pair_function, r, 0, k_p, reach, 0.0, c_max) / r
+                    u0 += push * d0
+                    u1 += push * d1
+                    u2 += push * d2
+            u[i, 0] = u0
+            if n_axes > 1:
+                u[i, 1] = u1
+            if n_axes > 2:
+                u[i, 2] = u2
+        # 4. formation pairs
+        for e in range(n_edges):
+            i = edge_i[e]
+            j = edge_j[e]
+            if not (active[i] and active[j]):
+                flag[e] = 0
+                continue
             r2 = 0.0
             dist2 = 0.0
             for a in range(n_axes):
-                d[a] = p_star[j, a] - p_star[i, a]
+                d[a] = nearest_image(p_star[j, a] - p_star[i, a], box[a])
                 r2 += d[a] * d[a]
-                dist2 += (x[j, a, 0] - x[i, a, 0]) ** 2
+                delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
+                dist2 += delta * delta
             r = np.sqrt(r2)
             dist = np.sqrt(dist2)
-            if dist < min_distance[p]:
-                min_distance[p] = dist
-            if coupled_function:
-                new = coupling.next_flag(flag[p], armed[p], r, d_t, eps)
-                if new != flag[p]:
-                    flag[p] = new
-                    event_step[n_events] = k
-                    event_kind[n_events] = coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE
-                    event_pair[n_events] = p
-                    event_action[n_events] = -1
-                    n_events += 1
-            if r > 0.0:
-                push = interaction.pair_control(function, r, flag[p], k_p, reach, d_t, c_max) / r
+            if dist < edge_min[e]:
+                edge_min[e] = dist
+            new = coupling.next_flag(flag[e], armed[e], r, edge_dt[e], eps) if couples else flag[e]
+            if new != flag[e]:
+                flag[e] = new
+                event_step[n_events] = k
+                event_kind[n_events] = coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE
+                event_i[n_events] = i
+                event_j[n_events] = j
+                event_action[n_events] = -1
+                n_events += 1
+            if flag[e] == 1 and not np.isnan(edge_dir[e, 0]):
+                norm2 = 0.0
+                for a in range(n_axes):
+                    v[a] = k_p * (d[a] - edge_dir[e, a] * edge_dt[e])
+                    norm2 += v[a] * v[a]
+                scale = min(1.0, c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
+                for a in range(n_axes):
+                    u[i, a] += scale * v[a]
+                    u[j, a] -= scale * v[a]
+            elif r > 0.0:
+                push = interaction.pair_control(function, r, flag[e], k_p, reach, edge_dt[e], c_max) / r
                 for a in range(n_axes):
                     u[i, a] += push * d[a]
                     u[j, a] -= push * d[a]
-        # 4. saturation of the summed set-point
-        for i in range(n_agents):
+        # 5. saturation of the set-point's norm; 7. exact zero-order-hold step of (2)
+        for i in numba.prange(n_agents):
+            norm2 = 0.0
             for a in range(n_axes):
-                u[i, a] = min(max(u[i, a], -c_max), c_max)
-        # 5. recording
-        if k % record_every == 0 or k == n_steps:
-            rec_state[next_record] = x
-            rec_control[next_record] = u
-            rec_flag[next_record] = flag
-            next_record += 1
-        # 6. exact zero-order-hold step of (2)
-        if k < n_steps:
-            for i in range(n_agents):
+                norm2 += u[i, a] * u[i, a]
+            if norm2 > c_max * c_max:
+                scale = c_max / np.sqrt(norm2)
                 for a in range(n_axes):
+                    u[i, a] *= scale
+            if not active[i]:
+                for a in range(n_axes):
+                    u[i, a] = 0.0
+        # 6. recording (before the step, with the control applied over it)
+        if record_every > 0 and (k % record_every == 0 or k == n_steps):
+            for q in range(rec_agents.shape[0]):
+                i = rec_agents[q]
+                rec_state[next_record, q] = x[i]
+                rec_control[next_record, q] = u[i]
+                rec_active[next_record, q] = active[i]
+            for e in range(n_edges):
+                rec_flag[next_record, e] = flag[e]
+                dist2 = 0.0
+                r2 = 0.0
+                for a in range(n_axes):
+                    delta = nearest_image(x[edge_j[e], a, 0] - x[edge_i[e], a, 0], box[a])
+                    dist2 += delta * delta
+                    delta = nearest_image(p_star[edge_j[e], a] - p_star[edge_i[e], a], box[a])
+                    r2 += delta * delta
+                rec_dist[next_record, e] = np.sqrt(dist2)
+                rec_dstar[next_record, e] = np.sqrt(r2)
+            next_record += 1
+        if k < n_steps:
+            for i in numba.prange(n_agents):
+                if not active[i]:
+                    continue
+                for a in range(n_axes):
+                    x0 = x[i, a, 0]
+                    x1 = x[i, a, 1]
+                    x2 = x[i, a, 2]
+                    x3 = x[i, a, 3]
+                    ui = u[i, a]
                     for m in range(4):
-                        s = bd[m] * u[i, a]
-                        for q in range(4):
-                            s += ad[m, q] * x[i, a, q]
-                        x_new[m] = s
-                    for m in range(4):
-                        x[i, a, m] = x_new[m]
-    return next_command, next_record, n_events
+                        x[i, a, m] = ad[m, 0] * x0 + ad[m, 1] * x1 + ad[m, 2] * x2 + ad[m, 3] * x3 + bd[m] * ui
+                    if box[a] > 0.0:
+                        x[i, a, 0] -= box[a] * np.floor(x[i, a, 0] / box[a])
+    return k_stop, next_command, next_record, n_events, 0
+
+
+_advance_serial = numba.njit(cache=True, error_model="numpy")(_advance_source)
+_advance_threaded = numba.njit(cache=True, parallel=True, error_model="numpy")(_advance_source)
 
 
 def record_steps(n_steps: int, record_every: int) -> np.ndarray:
@@ -174,16 +339,37 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
     return steps
 
 
-def initial_state(scenario: Scenario) -> np.ndarray:
-    """Initial states shaped ``(agents, axes=1, 4)`` from the scenario's ``[[agents]]``."""
-    rows = [[a.position, a.velocity, a.tilt, a.tilt_rate] for a in scenario.agents]
-    return np.array(rows, dtype=float)[:, None, :]
+def _commands(scenario: Scenario, edges: np.ndarray, dt: float):
+    """Commands as arrays: step, kind, and targets (pair indices, or the agent) in rows."""
+    index = {(int(i), int(j)): e for e, (i, j) in enumerate(edges)}
+    commands = sorted(scenario.commands, key=lambda cmd: cmd.time)
+    step = np.array([int(round(cmd.time / dt)) for cmd in commands], dtype=np.int64)
+    kind = np.array([_COMMAND_CODES[cmd.action] for cmd in commands], dtype=np.int64)
+    targets = []
+    for cmd in commands:
+        if cmd.agent is not None:
+            targets.append([cmd.agent])
+        else:
+            targets.append([index[(min(i, j), max(i, j))] for i, j in cmd.targets or []])
+    ptr = np.cumsum([0] + [len(t) for t in targets]).astype(np.int64)
+    flat = np.array([t for row in targets for t in row], dtype=np.int64)
+    return step, kind, ptr, flat
+
+
+def _partners(n_agents: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each agent's formation partners, in rows ``(ptr, idx)``."""
+    both = np.concatenate([edges, edges[:, ::-1]]) if len(edges) else np.empty((0, 2), dtype=np.int64)
+    order = np.lexsort((both[:, 1], both[:, 0]))
+    both = both[order]
+    ptr = np.searchsorted(both[:, 0], np.arange(n_agents + 1)).astype(np.int64)
+    return ptr, both[:, 1].astype(np.int64).copy()
 
 
 def simulate(
     scenario: Scenario,
     progress: Callable[[int, int], None] | None = None,
     chunk_seconds: float = 0.1,
+    record: bool = True,
 ) -> Trajectory:
     """Run a scenario and return its :class:`Trajectory`.
 
@@ -194,42 +380,59 @@ def simulate(
     progress
         Called as ``progress(steps_done, steps_total)`` between chunks of the
         compiled loop; chunks last about ``chunk_seconds``.
+    record
+        ``False`` records nothing but the end state (for benchmarks).
     """
     m, c, ia, sim = scenario.model, scenario.controller, scenario.interaction, scenario.simulation
     a, b = state_matrices(m.kp, m.kd, m.g)
     ad, bd = zero_order_hold(a, b, sim.dt)
     gains = modal_gains(m.kp, m.kd, m.g, c.r_l, c.im_l, c.im_r)
+    setup: Setup = build(scenario)
 
-    x = initial_state(scenario)
-    n_agents = x.shape[0]
-    pairs = all_pairs(n_agents)
-    n_pairs = len(pairs)
-    pair_index = {(int(i), int(j)): p for p, (i, j) in enumerate(pairs)}
+    x = setup.state.copy()
+    x_start = setup.state.copy()
+    active = setup.active.copy()
+    n_agents, n_axes, _ = x.shape
+    edges = setup.edges
+    n_edges = len(edges)
+    edge_i = edges[:, 0].astype(np.int64).copy()
+    edge_j = edges[:, 1].astype(np.int64).copy()
+    adj_ptr, adj_idx = _partners(n_agents, edges)
+    flag = setup.flag.copy()
+    armed = np.ones(n_edges, dtype=np.int64)
 
-    commands = sorted(scenario.commands, key=lambda cmd: cmd.time)
-    command_step = np.array([int(round(cmd.time / sim.dt)) for cmd in commands], dtype=np.int64)
-    command_pair = np.array(
-        [-1 if cmd.pair is None else pair_index[tuple(sorted(cmd.pair))] for cmd in commands], dtype=np.int64
-    )
-    command_arm = np.array([coupling.ACTIONS.index(cmd.action) for cmd in commands], dtype=np.int64)
+    method = scenario.neighbors.method
+    use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
+    if use_lists:
+        nbr_ptr = np.zeros(n_agents + 1, dtype=np.int64)
+        nbr_idx = np.empty(16 * n_agents, dtype=np.int32)
+    else:
+        nbr_ptr, nbr_idx = all_pairs(n_agents)
+    advance = _advance_threaded if n_agents >= LARGE_SWARM else _advance_serial
 
+    cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt)
     n_steps = sim.n_steps
-    steps = record_steps(n_steps, sim.record_every)
-    rec_state = np.empty((len(steps), *x.shape))
-    rec_control = np.empty((len(steps), n_agents, x.shape[1]))
-    rec_flag = np.empty((len(steps), n_pairs), dtype=np.int64)
-    # A pair changes flag at most once before any command and twice per command.
-    max_events = n_pairs * (1 + 2 * len(commands)) + len(commands)
+    steps = record_steps(n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
+    rec_agents = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents)
+    if not record:
+        rec_agents = rec_agents[:0]
+    rec_state = np.empty((len(steps), len(rec_agents), n_axes, 4))
+    rec_control = np.empty((len(steps), len(rec_agents), n_axes))
+    rec_active = np.empty((len(steps), len(rec_agents)), dtype=np.bool_)
+    rec_flag = np.empty((len(steps), n_edges), dtype=np.int64)
+    rec_dist = np.empty((len(steps), n_edges))
+    rec_dstar = np.empty((len(steps), n_edges))
+    # A pair changes flag at most once before any command and twice after each.
+    max_events = n_edges * (1 + 2 * len(cmd_step)) + len(cmd_step)
     event_step = np.empty(max_events, dtype=np.int64)
     event_kind = np.empty(max_events, dtype=np.int64)
-    event_pair = np.empty(max_events, dtype=np.int64)
+    event_i = np.empty(max_events, dtype=np.int64)
+    event_j = np.empty(max_events, dtype=np.int64)
     event_action = np.empty(max_events, dtype=np.int64)
-
-    armed = np.ones(n_pairs, dtype=np.int64)
-    flag = np.zeros(n_pairs, dtype=np.int64)
-    min_distance = np.full(n_pairs, np.inf)
-    function = interaction.FUNCTIONS.index(ia.function)
-    coupled_function = interaction.uses_coupling(ia.function)
+    edge_min = np.full(n_edges, np.inf)
+    agent_min = np.full(n_agents, np.inf)
+    p_ref = np.full((n_agents, n_axes), np.inf)  # no lists yet: stale at the first step
+    builds = 0
 
     next_command = next_record = n_events = 0
     k = 0
@@ -237,37 +440,58 @@ def simulate(
     while k <= n_steps:
         stop = min(k + chunk, n_steps + 1)
         started = _time.perf_counter()
-        next_command, next_record, n_events = _advance(
-            k, stop, n_steps, sim.record_every,
-            x, ad, bd, gains, function, gains[0], ia.reach, ia.d_t, ia.eps, ia.c_max, coupled_function,
-            pairs, armed, flag, min_distance,
-            command_step, command_pair, command_arm, next_command,
-            rec_state, rec_control, rec_flag, next_record,
-            event_step, event_kind, event_pair, event_action, n_events,
+        k, next_command, next_record, n_events, status = advance(
+            k, stop, n_steps, sim.record_every if record else 0,
+            x, active, x_start, ad, bd, gains,
+            interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function),
+            interaction.REPULSION if interaction.uses_coupling(ia.function) else interaction.FUNCTIONS.index(ia.function),
+            gains[0], ia.reach, ia.eps, ia.c_max, setup.box,
+            use_lists, scenario.neighbors.skin, nbr_ptr, nbr_idx, p_ref,
+            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, adj_ptr, adj_idx, edge_min, agent_min,
+            cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
+            rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
+            event_step, event_kind, event_i, event_j, event_action, n_events,
         )  # fmt: skip
+        if status == _LISTS_STALE:  # build the neighbour lists and go on from the same step
+            p_ref[:] = x @ (gains / gains[0])
+            cutoff = ia.reach + scenario.neighbors.skin
+            needed = verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
+            if needed > len(nbr_idx):
+                nbr_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
+                verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
+            builds += 1
+            continue
         elapsed = _time.perf_counter() - started
         if progress is not None:
-            progress(min(stop, n_steps), n_steps)
+            progress(min(k, n_steps), n_steps)
         # Grow chunks towards about chunk_seconds each (the first includes compilation).
         chunk = int(min(max(chunk * 4, 1000), max(1000, chunk * chunk_seconds / max(elapsed, 1e-9))))
-        k = stop
 
     events = []
     for e in range(n_events):
-        p = event_pair[e]
-        agents = (-1, -1) if p < 0 else (int(pairs[p, 0]), int(pairs[p, 1]))
         kind = coupling.EVENT_KINDS[event_kind[e]]
-        action = coupling.ACTIONS[event_action[e]] if kind == "command" else None
+        agents = tuple(int(v) for v in (event_i[e], event_j[e]) if v >= 0)
+        action = next(name for name, code in _COMMAND_CODES.items() if code == event_action[e]) if kind == "command" else None
         events.append(Event(time=round(float(event_step[e] * sim.dt), 12), kind=kind, agents=agents, action=action))
 
+    min_neighbor = float(np.sqrt(agent_min.min())) if n_agents else np.inf
     return Trajectory(
         scenario=scenario,
+        setup=setup,
         gains=gains,
         time=steps * sim.dt,
+        agents=rec_agents,
         state=rec_state,
         control=rec_control,
-        pairs=pairs,
+        active=rec_active,
         flag=rec_flag,
-        min_distance=min_distance,
+        pair_distance=rec_dist,
+        interaction_distance=rec_dstar,
+        min_distance=edge_min,
+        min_neighbor_distance=min_neighbor,
+        final_state=x,
+        final_active=active,
         events=events,
+        list_builds=builds,
     )
+

@@ -45,12 +45,12 @@ def uses_coupling(function: str) -> bool:
     return FUNCTIONS.index(function) >= SWITCHING
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _saturate(u: float, c_max: float) -> float:
     return min(max(u, -c_max), c_max)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _sign(d: float) -> float:
     return (d > 0.0) - (d < 0.0)
 

@@ -43,52 +43,45 @@ class OutputError(ValueError):
 def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     """The recorded trajectory as an :class:`xarray.Dataset`.
 
-    Dimensions ``time``, ``agent``, ``axis`` and ``pair``; variables ``P``,
-    ``V``, ``phi``, ``omega`` and the control ``U`` over (time, agent, axis);
-    the coupling flag ``F_en``, the distance and the interaction distance
-    ``|d|`` (6) over (time, pair); the RMS velocity over time.  Units are in
-    each variable's attributes; the scenario (as TOML), the gains and the
-    events are in the dataset's attributes.
+    Dimensions ``time``, ``agent`` (the recorded agents, by index), ``axis``
+    and ``pair``; variables ``P``, ``V``, ``phi``, ``omega`` and the control
+    ``U`` over (time, agent, axis); ``active`` over (time, agent); the
+    coupling flag ``F_en``, the distance and the interaction distance ``|d|``
+    (6) over (time, pair); each pair's set distance ``d_t``; the RMS velocity
+    of the recorded agents over time.  Units are in each variable's
+    attributes; the scenario (as TOML), the gains and the events are in the
+    dataset's attributes.
     """
-    n_axes = trajectory.state.shape[2]
+    n_axes = trajectory.scenario.space.axes
     coords = {
         "time": ("time", trajectory.time, {"units": "s"}),
-        "agent": np.arange(trajectory.state.shape[1]),
+        "agent": trajectory.agents,
         "axis": ["x", "y", "z"][:n_axes],
         "pair": np.arange(len(trajectory.pairs)),
         "pair_i": ("pair", trajectory.pairs[:, 0], {"long_name": "first agent of the pair"}),
         "pair_j": ("pair", trajectory.pairs[:, 1], {"long_name": "second agent of the pair"}),
     }
+    over_agents = ("time", "agent", "axis")
+    over_pairs = ("time", "pair")
     data = {}
     for m, name in enumerate(STATE_NAMES):
         long_name, units = _STATE_ATTRS[name]
-        data[name] = (("time", "agent", "axis"), trajectory.state[..., m], {"long_name": long_name, "units": units})
-    data["U"] = (
-        ("time", "agent", "axis"),
-        trajectory.control,
-        {"long_name": "tilt set-point (control)", "units": "rad"},
-    )
-    data["F_en"] = (
-        ("time", "pair"),
-        trajectory.flag.astype(np.int8),
-        {"long_name": "pair coupling flag F_en", "units": "1"},
-    )
-    data["distance"] = (
-        ("time", "pair"),
-        metrics.distance(trajectory),
-        {"long_name": "distance |P_j - P_i|", "units": "m"},
-    )
+        data[name] = (over_agents, trajectory.state[..., m], {"long_name": long_name, "units": units})
+    data["U"] = (over_agents, trajectory.control, {"long_name": "tilt set-point (control)", "units": "rad"})
+    data["active"] = (("time", "agent"), trajectory.active.astype(np.int8), {"long_name": "agent flying", "units": "1"})
+    data["F_en"] = (over_pairs, trajectory.flag.astype(np.int8), {"long_name": "pair coupling flag F_en", "units": "1"})
+    data["distance"] = (over_pairs, trajectory.pair_distance, {"long_name": "distance |P_j - P_i|", "units": "m"})
     data["interaction_distance"] = (
-        ("time", "pair"),
-        metrics.interaction_distance(trajectory),
+        over_pairs,
+        trajectory.interaction_distance,
         {"long_name": "interaction distance |P*_j - P*_i|, (6)", "units": "m"},
     )
+    data["d_t"] = ("pair", trajectory.d_t, {"long_name": "set distance of the pair", "units": "m"})
     data["rms_velocity"] = (
         ("time",),
-        metrics.rms_velocity(trajectory.state[..., 1]),
-        {"long_name": "RMS velocity over agents", "units": "m s-1"},
+        metrics.rms_velocity(trajectory.state[..., 1], trajectory.active),
+        {"long_name": "RMS velocity over the recorded agents flying", "units": "m s-1"},
     )
-    summary_events = metrics.summarize_events(trajectory.events)
     attrs = {
         "title": f"tmem run {trajectory.scenario.name}".strip(),
         "source": f"tmem {__version__}",
@@ -96,7 +89,7 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
         "scenario": trajectory.scenario.to_toml(),
         "gains": trajectory.gains,
         "gains_order": "K_P K_V K_phi K_omega",
-        "events": json.dumps(summary_events),
+        "events": json.dumps(metrics.summarize_events(trajectory.events)),
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
 

@@ -1,93 +1,148 @@
-"""What a run measured: RMS velocity, distances, coupling events, oscillation.
+"""What a run measured: RMS velocity, distances, coupling events, formation errors.
 
 The swarm's "temperature" in TMEM is its RMS velocity,
-``sqrt(mean_i |v_i|^2)`` over agents; an encounter that keeps it is lossless
-in the thermal-motion sense.
+``sqrt(mean_i |v_i|^2)`` over the agents flying; an encounter that keeps it
+is lossless in the thermal-motion sense.  A formation is judged per pair by
+its distance error ``|P_j - P_i| - d_t`` (and, where a direction is held, the
+angle to it), over the recorded samples.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from .control import interaction_point
 from .engine import Event, Trajectory
 
 
-def rms_velocity(velocity: np.ndarray) -> np.ndarray:
-    """RMS velocity over agents, ``sqrt(mean_i sum_axes v_i^2)``.
+def rms_velocity(velocity: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
+    """RMS velocity over agents, ``sqrt(mean_i sum_axes v_i^2)``, counting only ``active`` agents.
 
     Parameters
     ----------
     velocity : ndarray, shape (..., agents, axes)
+    active : ndarray, shape (..., agents), bool, optional
     """
-    return np.sqrt(np.mean(np.sum(velocity**2, axis=-1), axis=-1))
+    speed2 = np.sum(velocity**2, axis=-1)
+    if active is None:
+        return np.sqrt(np.mean(speed2, axis=-1))
+    count = np.sum(active, axis=-1)
+    return np.sqrt(np.sum(np.where(active, speed2, 0.0), axis=-1) / np.maximum(count, 1))
 
 
-def pair_distances(positions: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """Euclidean distances ``|P_j - P_i|`` of each pair.
-
-    Parameters
-    ----------
-    positions : ndarray, shape (..., agents, axes)
-    pairs : ndarray, shape (n_pairs, 2)
-
-    Returns
-    -------
-    ndarray, shape (..., n_pairs)
-    """
-    diff = positions[..., pairs[:, 1], :] - positions[..., pairs[:, 0], :]
-    return np.sqrt(np.sum(diff**2, axis=-1))
-
-
-def distance(trajectory: Trajectory) -> np.ndarray:
-    """Physical distance of each pair at each recorded time, shape (n_records, n_pairs)."""
-    return pair_distances(trajectory.state[..., 0], trajectory.pairs)
-
-
-def interaction_distance(trajectory: Trajectory) -> np.ndarray:
-    """``|d| = |P*_j - P*_i|`` (6) of each pair at each recorded time, shape (n_records, n_pairs)."""
-    return pair_distances(interaction_point(trajectory.state, trajectory.gains), trajectory.pairs)
+def nearest_distance(positions: np.ndarray, active: np.ndarray, box: np.ndarray) -> float | None:
+    """Smallest distance between two active agents (nearest image in a periodic box)."""
+    points = positions[active]
+    if len(points) < 2:
+        return None
+    periodic = bool(np.all(box > 0))
+    tree = cKDTree(np.mod(points, box) if periodic else points, boxsize=box if periodic else None)
+    distances, _ = tree.query(np.mod(points, box) if periodic else points, k=2)
+    return float(distances[:, 1].min())
 
 
 def _first(times: list[float]) -> float | None:
     return min(times) if times else None
 
 
-def pair_summary(trajectory: Trajectory, p: int, dist: np.ndarray) -> dict:
-    """Per-pair figures: coupling and uncoupling times, separation, distances, oscillation.
+def pair_summary(trajectory: Trajectory, p: int) -> dict:
+    """Per-pair figures: coupling and uncoupling times, separation, distances, oscillation, errors.
 
     ``separated_at`` is the first recorded time after the pair uncoupled at
     which its distance reaches ``R + R_j`` (the spheres no longer intersect):
     the paper's "actual disconnection".  ``oscillation_amplitude`` is half the
-    peak-to-peak distance over the recorded samples with ``F_en = 1``.
+    peak-to-peak distance over the recorded samples with ``F_en = 1``;
+    ``distance_error`` the mean, RMS and largest ``|distance - d_t|`` over the
+    same samples.
     """
     agents = tuple(int(a) for a in trajectory.pairs[p])
     events = [e for e in trajectory.events if e.agents == agents]
     coupled_at = _first([e.time for e in events if e.kind == "couple"])
     uncoupled_at = _first([e.time for e in events if e.kind == "uncouple"])
+    dist = trajectory.pair_distance[:, p]
     separated_at = None
     if uncoupled_at is not None:
-        reach = trajectory.scenario.interaction.reach
-        after = (trajectory.time >= uncoupled_at) & (dist[:, p] >= reach)
+        after = (trajectory.time >= uncoupled_at) & (dist >= trajectory.scenario.interaction.reach)
         separated_at = float(trajectory.time[np.argmax(after)]) if after.any() else None
-    while_coupled = dist[trajectory.flag[:, p] == 1, p]
+    while_coupled = dist[trajectory.flag[:, p] == 1]
+    error = np.abs(while_coupled - trajectory.d_t[p])
     return {
         "agents": list(agents),
+        "d_t": float(trajectory.d_t[p]),
         "coupled_at": coupled_at,
         "uncoupled_at": uncoupled_at,
         "separated_at": separated_at,
         "min_distance": float(trajectory.min_distance[p]),
-        "final_distance": float(dist[-1, p]),
+        "final_distance": float(dist[-1]) if len(dist) else None,
         "mean_distance_coupled": float(while_coupled.mean()) if while_coupled.size else None,
         "oscillation_amplitude": float(np.ptp(while_coupled) / 2) if while_coupled.size else None,
+        "distance_error": _error_stats(error),
     }
+
+
+def _error_stats(error: np.ndarray) -> dict | None:
+    if not error.size:
+        return None
+    return {"mean": float(error.mean()), "rms": float(np.sqrt(np.mean(error**2))), "max": float(error.max())}
+
+
+def formation_summary(trajectory: Trajectory) -> dict | None:
+    """Formation figures over all its pairs, or ``None`` without a formation.
+
+    ``distance_error``: mean, RMS and largest ``|distance - d_t|`` over every
+    pair and every recorded sample while coupled; ``direction_error_deg``: the
+    largest angle between a pair's direction ``P_j - P_i`` and the direction it
+    must hold (pairs that hold one); ``formed_at``: when the last pair coupled,
+    if all did; ``coupled_at_end``: the share of pairs coupled at the end.
+    """
+    scenario = trajectory.scenario
+    if scenario.formation is None or not len(trajectory.pairs):
+        return None
+    flag = trajectory.flag == 1
+    error = np.abs(trajectory.pair_distance - trajectory.d_t)[flag]
+    couple_times = {}
+    for e in trajectory.events:
+        if e.kind == "couple":
+            couple_times.setdefault(e.agents, e.time)
+    start = scenario.formation.coupled
+    formed_at = 0.0 if start else (max(couple_times.values()) if len(couple_times) == len(trajectory.pairs) else None)
+    result = {
+        "pairs": len(trajectory.pairs),
+        "distance_error": _error_stats(error),
+        "formed_at": formed_at,
+        "coupled_at_end": float(flag[-1].mean()) if len(flag) else None,
+        "amplitude_max": None,
+    }
+    amplitudes = [
+        np.ptp(trajectory.pair_distance[flag[:, p], p]) / 2 for p in range(len(trajectory.pairs)) if flag[:, p].any()
+    ]
+    result["amplitude_max"] = float(max(amplitudes)) if amplitudes else None
+    if scenario.formation.bearing:
+        result["direction_error_deg"] = direction_error_deg(trajectory)
+    return result
+
+
+def direction_error_deg(trajectory: Trajectory) -> float | None:
+    """Largest angle (degrees) between a recorded pair's direction and the one it must hold."""
+    direction = trajectory.setup.direction
+    position = {int(a): q for q, a in enumerate(trajectory.agents)}
+    worst = None
+    for p, (i, j) in enumerate(trajectory.pairs.tolist()):
+        if np.isnan(direction[p, 0]) or i not in position or j not in position:
+            continue
+        delta = trajectory.state[:, position[j], :, 0] - trajectory.state[:, position[i], :, 0]
+        cosine = (delta @ direction[p]) / np.linalg.norm(delta, axis=1)
+        angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))[trajectory.flag[:, p] == 1]
+        if angle.size:
+            worst = max(worst or 0.0, float(angle.max()))
+    return worst
 
 
 def summarize_events(events: list[Event]) -> list[dict]:
     """Events as JSON-ready dicts; ``agents`` is ``[]`` for a command to every pair."""
     rows = []
     for e in events:
-        row = {"time": e.time, "kind": e.kind, "agents": [] if e.agents[0] < 0 else list(e.agents)}
+        row = {"time": e.time, "kind": e.kind, "agents": list(e.agents)}
         if e.action is not None:
             row["action"] = e.action
         rows.append(row)
@@ -97,31 +152,38 @@ def summarize_events(events: list[Event]) -> list[dict]:
 def summarize(trajectory: Trajectory) -> dict:
     """The run's summary, as written to ``summary.json``.
 
-    Top-level figures aggregate over pairs: ``min_distance`` is the smallest
-    distance any pair reached at any step, ``final_distance`` the smallest
-    pair distance at the end, ``coupled`` whether any pair coupled,
-    ``couple_time`` / ``uncouple_time`` the first such event of any pair.
+    ``min_distance`` is the smallest distance two agents reached at any step
+    (formation pairs always; other pairs once within ``R + R_j``);
+    ``final_distance`` the smallest distance between two flying agents at the
+    end; ``coupled`` whether any pair coupled; ``couple_time`` /
+    ``uncouple_time`` the first such event of any pair.
     """
-    velocity = trajectory.state[..., 1]
-    rms = rms_velocity(velocity[[0, -1]])
-    dist = distance(trajectory)
-    pairs = [pair_summary(trajectory, p, dist) for p in range(len(trajectory.pairs))]
     scenario = trajectory.scenario
+    rms = [
+        rms_velocity(trajectory.setup.state[..., 1], trajectory.setup.active),
+        rms_velocity(trajectory.final_state[..., 1], trajectory.final_active),
+    ]
+    box = trajectory.setup.box
+    min_pairs = float(trajectory.min_distance.min()) if len(trajectory.min_distance) else np.inf
+    min_distance = min(min_pairs, trajectory.min_neighbor_distance)
     return {
         "scenario": scenario.name,
         "function": scenario.interaction.function,
+        "agents": int(trajectory.final_state.shape[0]),
+        "axes": scenario.space.axes,
         "dt": scenario.simulation.dt,
         "duration": scenario.simulation.duration,
         "rms_velocity_initial": float(rms[0]),
         "rms_velocity_final": float(rms[1]),
         "rms_change_percent": float(100.0 * (rms[1] / rms[0] - 1.0)) if rms[0] > 0 else None,
-        "min_distance": float(trajectory.min_distance.min()),
-        "final_distance": float(dist[-1].min()),
+        "min_distance": float(min_distance) if np.isfinite(min_distance) else None,
+        "final_distance": nearest_distance(trajectory.final_state[:, :, 0], trajectory.final_active, box),
         "coupled": any(e.kind == "couple" for e in trajectory.events),
         "couple_time": _first([e.time for e in trajectory.events if e.kind == "couple"]),
         "uncouple_time": _first([e.time for e in trajectory.events if e.kind == "uncouple"]),
-        "final_velocities": velocity[-1].tolist(),
+        "final_velocities": trajectory.final_state[..., 1].tolist() if trajectory.final_state.shape[0] <= 100 else None,
         "events": summarize_events(trajectory.events),
         "gains": trajectory.gains.tolist(),
-        "pairs": pairs,
+        "formation": formation_summary(trajectory),
+        "pairs": [pair_summary(trajectory, p) for p in range(len(trajectory.pairs))],
     }

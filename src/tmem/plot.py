@@ -1,8 +1,10 @@
 """Figures of a run, in the layout of the paper's Figs. 5, 7 and 9.
 
-``velocity.png``: each agent's velocity and the RMS velocity against time.
-``distance.png``: the pair distance against time with ``R + R_j`` and
-``d_t`` marked and the coupling events, above the flag ``F_en``.
+``velocity.png``: each agent's velocity (speed, on several axes) and the
+RMS velocity against time.  ``distance.png``: pair distances against time
+with ``R + R_j`` and ``d_t`` marked and the coupling events, above the flags
+``F_en``.  ``formation.png`` (formations only): the distance error of the
+formation's pairs against time.
 """
 
 from __future__ import annotations
@@ -18,8 +20,8 @@ import numpy as np  # noqa: E402
 from . import metrics  # noqa: E402
 from .engine import Trajectory  # noqa: E402
 
-#: Most pairs drawn in one figure; the closest ones are chosen.
-MAX_PAIRS_DRAWN = 8
+#: Most agents or pairs drawn one by one in a figure.
+MAX_DRAWN = 8
 _EVENT_STYLE = {"couple": ("tab:green", "-"), "uncouple": ("tab:red", "-"), "command": ("0.4", ":")}
 
 
@@ -30,28 +32,30 @@ def _title(trajectory: Trajectory) -> str:
 
 
 def _mark_events(ax, trajectory: Trajectory) -> None:
+    events = trajectory.events if len(trajectory.events) <= 4 * MAX_DRAWN else [
+        e for e in trajectory.events if e.kind == "command"
+    ]  # fmt: skip
     seen = set()
-    for e in trajectory.events:
+    for e in events:
         color, style = _EVENT_STYLE[e.kind]
-        label = e.kind if e.kind not in seen else None
+        ax.axvline(e.time, color=color, linestyle=style, linewidth=1, label=None if e.kind in seen else e.kind)
         seen.add(e.kind)
-        ax.axvline(e.time, color=color, linestyle=style, linewidth=1, label=label)
 
 
 def velocity_figure(trajectory: Trajectory):
-    """Velocities of the agents and their RMS velocity against time."""
+    """Velocities of (up to MAX_DRAWN) agents and the RMS velocity against time."""
     fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
     t = trajectory.time
     velocity = trajectory.state[..., 1]
-    n_axes = velocity.shape[2]
-    for i in range(velocity.shape[1]):
-        for a in range(n_axes):
-            suffix = f" ({'xyz'[a]})" if n_axes > 1 else ""
-            ax.plot(t, velocity[:, i, a], linewidth=1.2, label=f"V{i}{suffix}")
-    ax.plot(t, metrics.rms_velocity(velocity), color="k", linestyle="--", linewidth=1.5, label="RMS velocity")
+    one_axis = velocity.shape[2] == 1
+    for q in range(min(MAX_DRAWN, velocity.shape[1])):
+        value = velocity[:, q, 0] if one_axis else np.linalg.norm(velocity[:, q], axis=1)
+        ax.plot(t, value, linewidth=1.2, label=f"{'V' if one_axis else '|V|'}{trajectory.agents[q]}")
+    rms = metrics.rms_velocity(velocity, trajectory.active)
+    ax.plot(t, rms, color="k", linestyle="--", linewidth=1.5, label="RMS velocity")
     _mark_events(ax, trajectory)
     ax.set_xlabel("time, s")
-    ax.set_ylabel("velocity, m/s")
+    ax.set_ylabel("velocity, m/s" if one_axis else "speed, m/s")
     ax.set_title(_title(trajectory))
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
@@ -59,20 +63,19 @@ def velocity_figure(trajectory: Trajectory):
 
 
 def distance_figure(trajectory: Trajectory):
-    """Pair distance with ``R + R_j`` and ``d_t`` marked, above the coupling flag."""
+    """Distances of (up to MAX_DRAWN of the closest) pairs with ``R + R_j`` and ``d_t``, above ``F_en``."""
     fig, (top, bottom) = plt.subplots(
         2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained"
     )
     t = trajectory.time
-    dist = metrics.distance(trajectory)
-    shown = np.argsort(trajectory.min_distance)[:MAX_PAIRS_DRAWN]
     ia = trajectory.scenario.interaction
-    for p in shown:
+    for p in np.argsort(trajectory.min_distance)[:MAX_DRAWN]:
         i, j = trajectory.pairs[p]
-        top.plot(t, dist[:, p], linewidth=1.2, label=f"|P{j} - P{i}|")
+        top.plot(t, trajectory.pair_distance[:, p], linewidth=1.2, label=f"|P{j} - P{i}|")
         bottom.step(t, trajectory.flag[:, p], where="post", linewidth=1.2, label=f"pair {i}-{j}")
     top.axhline(ia.reach, color="tab:purple", linestyle="--", linewidth=1, label=f"R + R_j = {ia.reach:g} m")
-    top.axhline(ia.d_t, color="tab:olive", linestyle="--", linewidth=1, label=f"d_t = {ia.d_t:g} m")
+    for d_t in np.unique(trajectory.d_t)[:3]:
+        top.axhline(d_t, color="tab:olive", linestyle="--", linewidth=1, label=f"d_t = {d_t:g} m")
     _mark_events(top, trajectory)
     top.set_ylabel("distance, m")
     top.set_title(_title(trajectory))
@@ -86,10 +89,37 @@ def distance_figure(trajectory: Trajectory):
     return fig
 
 
+def formation_figure(trajectory: Trajectory):
+    """Distance error ``| |P_j - P_i| - d_t |`` of the coupled formation pairs: mean, RMS and largest."""
+    fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+    coupled = trajectory.flag == 1
+    error = np.where(coupled, np.abs(trajectory.pair_distance - trajectory.d_t), 0.0)
+    count = coupled.sum(axis=1)
+    some = count > 0
+    t = trajectory.time[some]
+    ax.plot(t, error[some].max(axis=1), color="tab:red", linewidth=1.2, label="largest")
+    ax.plot(t, np.sqrt((error[some] ** 2).sum(axis=1) / count[some]), color="k", linewidth=1.5, label="RMS")
+    ax.plot(t, error[some].sum(axis=1) / count[some], color="tab:blue", linewidth=1.2, label="mean")
+    _mark_events(ax, trajectory)
+    ax.set_xlabel("time, s")
+    ax.set_ylabel("| distance - d_t |, m (coupled pairs)")
+    ax.set_title(f"formation of {len(trajectory.pairs)} pairs; " + _title(trajectory))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    return fig
+
+
 def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
-    """Write ``velocity.png`` and ``distance.png`` into ``directory``."""
+    """Write ``velocity.png``, ``distance.png`` (if pairs) and ``formation.png`` (if a formation)."""
+    makers = [("velocity.png", velocity_figure)]
+    if len(trajectory.pairs):
+        makers.append(("distance.png", distance_figure))
+    if trajectory.scenario.formation is not None:
+        makers.append(("formation.png", formation_figure))
     paths = []
-    for name, make in (("velocity.png", velocity_figure), ("distance.png", distance_figure)):
+    if not len(trajectory.time) or not trajectory.state.shape[1]:
+        return paths
+    for name, make in makers:
         fig = make(trajectory)
         path = Path(directory) / name
         fig.savefig(path, dpi=120)

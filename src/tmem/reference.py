@@ -47,10 +47,10 @@ from scipy.optimize import brentq
 
 from . import interaction
 from .control import interaction_point, modal_gains
-from .engine import initial_state, record_steps
+from .engine import record_steps
 from .model import state_matrices
-from .neighbors import all_pairs
 from .scenario import Scenario
+from .setup import build
 
 #: Modes of a pair: ``|d| > reach``, ``|d| < reach``, or sliding on ``|d| = reach``.
 OUTSIDE, INSIDE, SLIDING = 0, 1, 2
@@ -63,7 +63,7 @@ def _check(scenario: Scenario) -> None:
             f"interaction.function: the continuous reference supports only functions without "
             f"the coupling flag F_en (repulsion, attraction), got {function!r}"
         )
-    n_axes = initial_state(scenario).shape[1]
+    n_axes = scenario.space.axes
     if n_axes != 1:
         raise ValueError(f"agents: the continuous reference supports one axis only, got {n_axes}")
 
@@ -108,9 +108,9 @@ def integrate(
     m, c, ia, sim = scenario.model, scenario.controller, scenario.interaction, scenario.simulation
     a, b = state_matrices(m.kp, m.kd, m.g)
     gains = modal_gains(m.kp, m.kd, m.g, c.r_l, c.im_l, c.im_r)
-    x0 = initial_state(scenario)[:, 0, :]
+    x0 = build(scenario).state[:, 0, :]
     n_agents = x0.shape[0]
-    first, second = all_pairs(n_agents).T
+    first, second = np.triu_indices(n_agents, k=1)
     reach, below_reach = ia.reach, np.nextafter(ia.reach, 0.0)
 
     def pair_measure(y: np.ndarray) -> np.ndarray:

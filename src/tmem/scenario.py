@@ -16,7 +16,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from .formation import generate
+from .interaction import uses_coupling
 
 PRESETS = ("fig5", "fig7", "fig9", "repulsion")
 
@@ -79,11 +83,12 @@ class InteractionParams(_Strict):
 
 
 class SimulationParams(_Strict):
-    """Time stepping and recording."""
+    """Time stepping and recording (``record_agents``: the agents recorded; all by default)."""
 
     dt: Positive = 1e-4
     duration: Positive = 60.0
     record_every: Annotated[int, Field(ge=1)] = 100
+    record_agents: list[int] | None = None
 
     @property
     def n_steps(self) -> int:
@@ -96,54 +101,282 @@ class SimulationParams(_Strict):
         return self
 
 
-class Agent(_Strict):
-    """Initial state of one agent along the axis (Table 2)."""
+class SpaceParams(_Strict):
+    """The space the agents fly in: 1 to 3 axes, optionally a periodic box."""
 
-    position: float
-    velocity: float = 0.0
-    tilt: float = 0.0
-    tilt_rate: float = 0.0
+    axes: Literal[1, 2, 3] = 1
+    periodic: bool = False
+    box: list[Positive] | None = None
+
+    @model_validator(mode="after")
+    def _box_fits(self) -> "SpaceParams":
+        if self.box is not None and len(self.box) != self.axes:
+            raise _FieldError("box", f"needs {self.axes} values (one per axis), got {len(self.box)}")
+        if self.periodic and self.box is None:
+            raise _FieldError("box", "is required when periodic = true")
+        return self
+
+
+class NeighborParams(_Strict):
+    """Neighbour search: every pair, or Verlet lists built from cells with a skin."""
+
+    method: Literal["auto", "all", "verlet"] = "auto"
+    skin: Positive = 4.0
+
+
+class FormationParams(_Strict):
+    """A formation: a generated shape, or edges among the ``[[agents]]``."""
+
+    kind: Literal["chain", "ring", "triangle", "hex", "edges"]
+    n: Annotated[int, Field(ge=2)] | None = None
+    d_t: Positive | None = None
+    bearing: bool = False
+    edges: list[tuple[int, int] | tuple[int, int, Positive]] | None = None
+    center: list[float] | None = None
+    velocity: list[float] | None = None
+    jitter: Annotated[float, Field(ge=0)] = 0.0
+    seed: int = 0
+    coupled: bool = True
+
+    @model_validator(mode="after")
+    def _kind_needs(self) -> "FormationParams":
+        if self.kind == "edges":
+            if not self.edges:
+                raise _FieldError("edges", 'is required (and not empty) for kind = "edges"')
+            for name in ("n", "center", "velocity"):
+                if getattr(self, name) is not None:
+                    raise _FieldError(name, 'is not used with kind = "edges": give the [[agents]]')
+        else:
+            if self.edges is not None:
+                raise _FieldError("edges", f'is only for kind = "edges", not {self.kind!r}')
+            if self.kind == "triangle" and self.n not in (None, 3):
+                raise _FieldError("n", f"a triangle has 3 agents, got {self.n}")
+            if self.kind in ("chain", "ring", "hex") and self.n is None:
+                raise _FieldError("n", f"is required for kind = {self.kind!r}")
+            if self.kind == "ring" and self.n is not None and self.n < 3:
+                raise _FieldError("n", f"a ring needs at least 3 agents, got {self.n}")
+        return self
+
+
+class SwarmParams(_Strict):
+    """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``."""
+
+    n: Annotated[int, Field(ge=2)]
+    seed: int = 0
+    region: list[Positive] | None = None
+    speed_rms: Annotated[float, Field(ge=0)] = 0.0
+
+
+Vector = float | list[float]
+
+
+class Agent(_Strict):
+    """Initial state of one agent (Table 2): a number per axis, or one number on one axis."""
+
+    position: Vector
+    velocity: Vector = 0.0
+    tilt: Vector = 0.0
+    tilt_rate: Vector = 0.0
+    active: bool = True
 
 
 class Command(_Strict):
-    """An operator's command at ``time``: couple or uncouple a pair (or every pair)."""
+    """An operator's command at ``time``.
+
+    ``couple`` / ``uncouple`` act on ``pair``, on the listed ``pairs``, or on
+    every formation pair when neither is given; ``remove`` / ``add`` act on
+    ``agent``.
+    """
 
     time: Annotated[float, Field(ge=0)]
-    action: Literal["couple", "uncouple"]
+    action: Literal["couple", "uncouple", "remove", "add"]
     pair: tuple[int, int] | None = None
+    pairs: list[tuple[int, int]] | None = None
+    agent: int | None = None
+
+    @model_validator(mode="after")
+    def _targets(self) -> "Command":
+        if self.action in ("couple", "uncouple"):
+            if self.agent is not None:
+                raise _FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
+            if self.pair is not None and self.pairs is not None:
+                raise _FieldError("pairs", "give pair or pairs, not both")
+        else:
+            if self.agent is None:
+                raise _FieldError("agent", f"is required for {self.action}")
+            if self.pair is not None or self.pairs is not None:
+                raise _FieldError("pair", f"is for couple / uncouple, not {self.action}")
+        return self
+
+    @property
+    def targets(self) -> list[tuple[int, int]] | None:
+        """The pairs a couple / uncouple command names; ``None`` for every pair."""
+        if self.pair is not None:
+            return [self.pair]
+        return self.pairs
+
+
+#: Beyond this many agents, a coupling function needs a [formation]: without one every pair
+#: would be a formation pair, and their number grows as the square of the swarm.
+MAX_AGENTS_ALL_PAIRS = 2000
+#: Without a formation, swarms up to this size have every pair tracked (recorded distances,
+#: per-pair figures) even when the function has no coupling flag.
+TRACK_ALL_PAIRS = 32
 
 
 class Scenario(_Strict):
-    """A whole scenario; see the module docstring."""
+    """A whole scenario; see the module docstring.
+
+    The agents come from exactly one of ``[[agents]]`` (Table 2),
+    ``[formation]`` with a generated ``kind`` (chain, ring, triangle, hex) or
+    ``[swarm]`` (random); ``[formation] kind = "edges"`` couples listed
+    ``[[agents]]``.  Without a formation, a coupling function (10) or (11)
+    treats every pair as a formation pair with the set distance
+    ``interaction.d_t``: the paper's two-agent case.
+    """
 
     name: str = ""
     model: ModelParams = ModelParams()
     controller: ControllerParams = ControllerParams()
     interaction: InteractionParams = InteractionParams()
     simulation: SimulationParams = SimulationParams()
-    agents: list[Agent] = Field(min_length=2)
+    space: SpaceParams = SpaceParams()
+    neighbors: NeighborParams = NeighborParams()
+    formation: FormationParams | None = None
+    swarm: SwarmParams | None = None
+    agents: list[Agent] = []
     commands: list[Command] = []
 
+    @property
+    def n_agents(self) -> int:
+        if self.swarm is not None:
+            return self.swarm.n
+        if self.formation is not None and self.formation.kind != "edges":
+            return 3 if self.formation.kind == "triangle" else self.formation.n
+        return len(self.agents)
+
+    def pairs(self) -> np.ndarray:
+        """The pairs handled one by one, ``(i, j)`` with ``i < j``, shape ``(m, 2)``.
+
+        The formation's edges; without a formation, every pair when the function
+        couples (the paper's case) or the swarm is small (at most
+        :data:`TRACK_ALL_PAIRS` agents), else none.  These pairs carry the flag
+        ``F_en`` and a distance record; all other neighbours only repel.
+        """
+        if self.formation is None:
+            n = self.n_agents
+            if not uses_coupling(self.interaction.function) and n > TRACK_ALL_PAIRS:
+                return np.empty((0, 2), dtype=np.int64)
+            i, j = np.triu_indices(n, k=1)
+            return np.stack([i, j], axis=1).astype(np.int64)
+        if self.formation.kind == "edges":
+            return np.array(sorted(sorted(e[:2]) for e in self.formation.edges), dtype=np.int64).reshape(-1, 2)
+        f = self.formation
+        return generate(f.kind, self.n_agents, f.d_t or self.interaction.d_t, self.space.axes).edges
+
     @model_validator(mode="after")
-    def _commands_fit(self) -> "Scenario":
-        n = len(self.agents)
-        for k, command in enumerate(self.commands):
+    def _consistent(self) -> "Scenario":
+        axes = self.space.axes
+        self._check_sources()
+        self._check_agents(axes)
+        n = self.n_agents
+        if n < 2:
+            raise _FieldError("agents", f"needs at least 2 agents, got {n}")
+        if self.formation is not None:
+            self._check_formation(axes, n)
+        elif uses_coupling(self.interaction.function) and n > MAX_AGENTS_ALL_PAIRS:
+            raise _FieldError(
+                "interaction.function",
+                f"{self.interaction.function!r} without a [formation] makes all {n * (n - 1) // 2} pairs "
+                f"formation pairs; give a [formation] or use 'repulsion' beyond {MAX_AGENTS_ALL_PAIRS} agents",
+            )
+        if self.swarm is not None:
+            region = self.swarm.region or self.space.box
+            if region is None:
+                raise _FieldError("swarm.region", "is required unless space.box is given")
+            if len(region) != axes:
+                raise _FieldError("swarm.region", f"needs {axes} values (one per axis), got {len(region)}")
+        if self.simulation.record_agents is not None:
+            for k, a in enumerate(self.simulation.record_agents):
+                if not 0 <= a < n:
+                    raise _FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
+        self._check_commands(n)
+        return self
+
+    def _check_sources(self) -> None:
+        generated = self.formation is not None and self.formation.kind != "edges"
+        sources = [name for name, given in (("agents", bool(self.agents)), ("formation", generated),
+                                            ("swarm", self.swarm is not None)) if given]  # fmt: skip
+        if len(sources) > 1:
+            raise _FieldError(sources[1], f"give the agents once: by {' or '.join(sources)}, not both")
+        if not sources:
+            raise _FieldError("agents", "no agents: give [[agents]], a [formation] or a [swarm]")
+
+    def _check_agents(self, axes: int) -> None:
+        for k, agent in enumerate(self.agents):
+            for name in ("position", "velocity", "tilt", "tilt_rate"):
+                value = getattr(agent, name)
+                if isinstance(value, list) and len(value) != axes:
+                    raise _FieldError(f"agents[{k}].{name}", f"needs {axes} values (one per axis), got {len(value)}")
+                if not isinstance(value, list) and axes > 1 and (name == "position" or value != 0.0):
+                    raise _FieldError(f"agents[{k}].{name}", f"needs a list of {axes} values for axes = {axes}")
+
+    def _check_formation(self, axes: int, n: int) -> None:
+        f = self.formation
+        if not uses_coupling(self.interaction.function):
+            raise _FieldError("formation", "needs interaction.function 'switching' (10) or 'improved' (11)")
+        if f.bearing and axes == 1:
+            raise _FieldError("formation.bearing", "a direction to hold needs 2 or 3 axes, got axes = 1")
+        if f.kind in ("ring", "triangle", "hex") and axes == 1:
+            raise _FieldError("formation.kind", f"{f.kind!r} is planar and needs 2 or 3 axes, got axes = 1")
+        d_t = f.d_t or self.interaction.d_t
+        if d_t >= self.interaction.reach:
+            raise _FieldError("formation.d_t", f"must be less than R + R_j = {self.interaction.reach:g} m, got {d_t:g}")
+        for name in ("center", "velocity"):
+            value = getattr(f, name)
+            if value is not None and len(value) != axes:
+                raise _FieldError(f"formation.{name}", f"needs {axes} values (one per axis), got {len(value)}")
+        if f.kind == "edges":
+            seen = set()
+            for k, edge in enumerate(f.edges):
+                i, j = edge[:2]
+                if not (0 <= i < n and 0 <= j < n) or i == j:
+                    raise _FieldError(f"formation.edges[{k}]", f"needs two different agents in 0..{n - 1}, got {list(edge)}")
+                if len(edge) == 3 and edge[2] >= self.interaction.reach:
+                    raise _FieldError(f"formation.edges[{k}]", f"d_t must be less than R + R_j = {self.interaction.reach:g} m")
+                if (min(i, j), max(i, j)) in seen:
+                    raise _FieldError(f"formation.edges[{k}]", f"repeats the pair {sorted((i, j))}")
+                seen.add((min(i, j), max(i, j)))
+
+    def _check_commands(self, n: int) -> None:
+        pairs = {tuple(e) for e in self.pairs().tolist()} if self.commands else set()
+        active = [a.active for a in self.agents] if self.agents else [True] * n
+        for k, command in sorted(enumerate(self.commands), key=lambda kc: kc[1].time):
+            where = f"commands[{k}]"
             if command.time > self.simulation.duration:
                 raise _FieldError(
-                    f"commands[{k}].time",
-                    f"must not be later than duration = {self.simulation.duration:g} s, got {command.time:g}",
+                    f"{where}.time", f"must not be later than duration = {self.simulation.duration:g} s, got {command.time:g}"
                 )
-            if command.pair is not None:
-                i, j = command.pair
+            if command.agent is not None:
+                if not 0 <= command.agent < n:
+                    raise _FieldError(f"{where}.agent", f"names agent {command.agent}, outside 0..{n - 1}")
+                wanted = command.action == "remove"
+                if active[command.agent] != wanted:
+                    state = "not flying" if wanted else "already flying"
+                    raise _FieldError(f"{where}.agent", f"cannot {command.action} agent {command.agent}: it is {state} then")
+                active[command.agent] = not wanted
+            field = f"{where}.pair" if command.pair is not None else f"{where}.pairs"
+            for i, j in command.targets or []:
                 if not (0 <= i < n and 0 <= j < n):
-                    raise _FieldError(f"commands[{k}].pair", f"names agent outside 0..{n - 1}: {list(command.pair)}")
+                    raise _FieldError(field, f"names agent outside 0..{n - 1}: {[i, j]}")
                 if i == j:
-                    raise _FieldError(f"commands[{k}].pair", f"needs two different agents, got {list(command.pair)}")
-        return self
+                    raise _FieldError(field, f"needs two different agents, got {[i, j]}")
+                if (min(i, j), max(i, j)) not in pairs:
+                    raise _FieldError(field, f"{[i, j]} is not a formation pair")
 
     def to_toml(self) -> str:
         """The scenario as TOML text, every default written out."""
-        return _to_toml(self.model_dump(mode="json"))
+        return _to_toml(self.model_dump(mode="json", exclude_none=True))
 
 
 class _FieldError(ValueError):
@@ -171,8 +404,6 @@ def _explain(error: dict) -> str:
         reason = "is required"
     elif kind == "finite_number":
         reason = f"must be a finite number, got {error['input']}"
-    elif kind == "too_short":
-        reason = f"needs at least {error['ctx']['min_length']} entries, got {error['ctx']['actual_length']}"
     else:
         ctx_error = error.get("ctx", {}).get("error")
         if isinstance(ctx_error, _FieldError):
