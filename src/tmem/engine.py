@@ -431,8 +431,23 @@ def simulate(
     event_action = np.empty(max_events, dtype=np.int64)
     edge_min = np.full(n_edges, np.inf)
     agent_min = np.full(n_agents, np.inf)
-    p_ref = np.full((n_agents, n_axes), np.inf)  # no lists yet: stale at the first step
+    p_ref = np.zeros((n_agents, n_axes))
     builds = 0
+
+    def build_lists(nbr_idx: np.ndarray) -> np.ndarray:
+        """Build the neighbour lists from the agents' P* now; returns the (possibly grown) index array."""
+        nonlocal builds
+        p_ref[:] = x @ (gains / gains[0])
+        cutoff = ia.reach + scenario.neighbors.skin
+        needed = verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
+        if needed > len(nbr_idx):
+            nbr_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
+            verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
+        builds += 1
+        return nbr_idx
+
+    if use_lists:
+        nbr_idx = build_lists(nbr_idx)
 
     next_command = next_record = n_events = 0
     k = 0
@@ -453,13 +468,7 @@ def simulate(
             event_step, event_kind, event_i, event_j, event_action, n_events,
         )  # fmt: skip
         if status == _LISTS_STALE:  # build the neighbour lists and go on from the same step
-            p_ref[:] = x @ (gains / gains[0])
-            cutoff = ia.reach + scenario.neighbors.skin
-            needed = verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
-            if needed > len(nbr_idx):
-                nbr_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
-                verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
-            builds += 1
+            nbr_idx = build_lists(nbr_idx)
             continue
         elapsed = _time.perf_counter() - started
         if progress is not None:
