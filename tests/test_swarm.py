@@ -95,7 +95,9 @@ def test_verlet_lists_match_brute_force(axes, periodic):
 
 
 def test_periodic_gas_keeps_momentum_and_stays_in_the_box():
-    tr = tmem.simulate(random_swarm(300, 2, True, "auto"))
+    """Pushes across the box edge are equal and opposite too.  With several neighbours, saturating
+    an agent's summed set-point breaks that symmetry, so c_max is set too high to saturate here."""
+    tr = tmem.simulate(with_changes(random_swarm(300, 2, True, "auto"), {"interaction.c_max": 10.0}))
     side = tr.setup.box[0]
     p0 = tr.setup.state[:, :, 1].sum(axis=0)
     np.testing.assert_allclose(tr.final_state[:, :, 1].sum(axis=0), p0, atol=1e-9)
@@ -146,7 +148,8 @@ def test_formation_survives_the_loss_of_an_agent(kind, n, lost):
     assert error.max() < 2.0  # ... and hold their distances
     q = list(tr.agents).index(lost)
     assert not tr.active[after, q].any()
-    np.testing.assert_array_equal(tr.state[after, q, :, 0], tr.state[after][0, q, :, 0])  # it stopped
+    stopped = tr.state[after, q, :, 0]
+    assert np.all(stopped == stopped[0])  # it stopped where it was lost
 
 
 def test_added_agent_starts_from_its_entry():
