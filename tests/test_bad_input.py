@@ -29,7 +29,7 @@ CASES = {
     "d_t beyond reach": (edit("d_t = 35.0", "d_t = 45.0"), "interaction.d_t", "less than R + R_j"),
     "radius zero": (edit("radius = 20.0", "radius = 0.0"), "interaction.radius", "must be greater than 0"),
     "radius negative": (edit("radius = 20.0", "radius = -1.0"), "interaction.radius", "must be greater than 0"),
-    "dt zero": (edit("dt = 0.0001", "dt = 0.0"), "simulation.dt", "must be greater than 0"),
+    "dt zero": (edit("dt = 0.0001", "dt = 0.0"), "simulation.dt", "must be greater than or equal to"),
     "duration negative": (edit("duration = 60.0", "duration = -5.0"), "simulation.duration", "must be greater than 0"),
     "c_max zero": (edit("c_max = 0.1", "c_max = 0.0"), "interaction.c_max", "must be greater than 0"),
     "eps negative": (edit("eps = 0.2", "eps = -0.2"), "interaction.eps", "must be greater than 0"),
@@ -46,7 +46,20 @@ CASES = {
     "command names one agent twice": (edit("pair = [0, 1]", "pair = [1, 1]"), "commands[0].pair", "two different"),
     "unstable left roots": (edit("r_l = 12.0", "r_l = -1.0"), "controller.r_l", "stable"),
     "zero r_l": (edit("r_l = 12.0", "r_l = 0.0"), "controller.r_l", "stable"),
-    "missing position": (edit("position = 0.0", "velocity_x = 1.0"), "agents[1]", ""),
+    "missing position": (edit("position = 0.0", "velocity_x = 1.0"), "agents[1].position", "is required"),
+    "boolean for a number": (edit("kp = 6.0", "kp = true"), "model.kp", "must be a valid number"),
+    "string for a number": (edit("kp = 6.0", 'kp = "6.0"'), "model.kp", "must be a valid number"),
+    "boolean for an index": (edit("pair = [0, 1]", "pair = [false, true]"), "commands[0].pair", "valid integer"),
+    "huge number": (edit("kp = 6.0", "kp = 1e308"), "model.kp", "less than or equal to"),
+    "tiny dt": (edit("dt = 0.0001", "dt = 1e-300"), "simulation.dt", "greater than or equal to"),
+    "fractional steps": (edit("dt = 0.0001", "dt = 0.7"), "simulation.duration", "whole number of steps"),
+    "agents at one point": (edit("position = 0.0", "position = 50.0"), "agents[1].position", "place of agents[0]"),
+    "records too big": (edit("record_every = 100", "record_every = 1").replace("duration = 60.0", "duration = 1e7"),
+                        "simulation.record_every", "GiB"),
+    "pair of three": (edit("pair = [0, 1]", "pair = [0, 1, 1]"), "commands[0].pair", "at most 2"),
+    "bearing on one axis": (GOOD + '\n[formation]\nkind = "edges"\nedges = [[0, 1]]\nbearing = true\n',
+                            "formation.bearing", "2 or 3 axes"),
+    "table as a number": (GOOD.replace("[model]\nkp = 6.0\nkd = 25.0\ng = 9.8", "model = 3"), "model", "must be a table"),
     "wrong type": (edit("kd = 25.0", 'kd = "fast"'), "model.kd", "number"),
     "toml syntax": (edit("kd = 25.0", "kd = = 25.0"), "TOML syntax error", "line 5"),
 }
@@ -80,14 +93,17 @@ def test_missing_file(tmp_path, runner):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root can read any file")
-def test_unreadable_file(tmp_path, runner):
+def test_unreadable_file(tmp_path, runner, monkeypatch):
     scenario = tmp_path / "secret.toml"
     scenario.write_text(GOOD)
-    scenario.chmod(0)
+
+    def refuse(self, *args, **kwargs):  # root reads any file, so refuse as a file system would
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "read_text", refuse)
     result = runner.invoke(app, ["run", str(scenario), "--out", str(tmp_path / "out")])
     assert result.exit_code == 2
-    assert "cannot be read" in result.stderr
+    assert "cannot be read" in result.stderr and "Permission denied" in result.stderr
 
 
 def test_directory_instead_of_file(tmp_path, runner):
@@ -104,16 +120,69 @@ def test_not_utf8(tmp_path, runner):
     assert "cannot be read" in result.stderr
 
 
-def test_output_directory_with_other_files_is_not_touched(tmp_path, runner):
+@pytest.mark.parametrize("marker", [None, "summary.json", "report.md"])
+def test_output_directory_with_other_files_is_not_touched(tmp_path, runner, marker):
+    """Even a directory that looks like an earlier run keeps files tmem did not write."""
     scenario = tmp_path / "ok.toml"
     scenario.write_text(GOOD)
     out = tmp_path / "thesis"
     out.mkdir()
     (out / "chapter1.tex").write_text("precious")
+    if marker:
+        (out / marker).write_text("{}")
     result = runner.invoke(app, ["run", str(scenario), "--out", str(out)])
     assert result.exit_code == 2
-    assert "not empty" in result.stderr
-    assert [p.name for p in out.iterdir()] == ["chapter1.tex"]
+    assert "did not write" in result.stderr
+    assert (out / "chapter1.tex").read_text() == "precious"
+
+
+def _ok_scenario(tmp_path):
+    scenario = tmp_path / "ok.toml"
+    scenario.write_text(GOOD)
+    return scenario
+
+
+def test_output_into_the_current_directory_is_refused(tmp_path, runner, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", "."])
+    assert result.exit_code == 2 and "current directory" in result.stderr
+
+
+def test_output_below_a_file_is_refused(tmp_path, runner):
+    (tmp_path / "afile").write_text("x")
+    result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", str(tmp_path / "afile" / "sub")])
+    assert result.exit_code == 2 and "is a file" in result.stderr
+
+
+def test_output_symlink_is_refused(tmp_path, runner):
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", str(tmp_path / "link")])
+    assert result.exit_code == 2 and "symbolic link" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "ok.toml", "real"]
+
+
+def test_unwritable_output_gives_one_line_and_leaves_nothing(tmp_path, runner, monkeypatch):
+    import tempfile
+
+    def full(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", full)
+    out = tmp_path / "new" / "deeper" / "out"
+    result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", str(out)])
+    assert result.exit_code == 2 and "No space left" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml"]  # the parents made for it are gone
+
+
+def test_agents_at_rest_run_and_report_no_rms_change(tmp_path, runner):
+    scenario = tmp_path / "rest.toml"
+    scenario.write_text(GOOD.replace("velocity = -1.5", "velocity = 0.0").replace("velocity = 3.0", "velocity = 0.0"))
+    result = runner.invoke(app, ["run", str(scenario), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    import json
+
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["rms_change_percent"] is None
 
 
 def test_console_script_exits_2_without_traceback(tmp_path):

@@ -73,9 +73,11 @@ def test_rerun_replaces_an_earlier_run(tmp_path):
     out = tmp_path / "o"
     runner = CliRunner()
     assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
-    (out / "stale.txt").write_text("from an earlier version")
+    (out / "formation.png").write_bytes(b"from an earlier run")  # a tmem file this run does not write
+    (out / "summary.json").write_text("{}")
     assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
-    assert not (out / "stale.txt").exists()
+    assert not (out / "formation.png").exists()
+    assert json.loads((out / "summary.json").read_text())["function"] == "repulsion"
     assert [p.name for p in tmp_path.iterdir()] == ["o"]  # no temporary directory left behind
 
 

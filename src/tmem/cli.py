@@ -16,7 +16,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from .engine import simulate
+from .engine import SimulationError, simulate
 from .io import OutputError, check_output_directory, write_run
 from .scenario import ScenarioError, load
 
@@ -58,13 +58,17 @@ def _fail(message: str) -> None:
     raise typer.Exit(2)
 
 
+def _number(value: float | None, form: str) -> str:
+    return "—" if value is None else form.format(value)
+
+
 def _summary_table(rows: dict[str, dict]) -> Table:
     table = Table("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
     for name, s in rows.items():
-        fmt = lambda v: "—" if v is None else f"{v:.2f}"  # noqa: E731
         table.add_row(
-            name, s["function"], "yes" if s["coupled"] else "no", fmt(s["couple_time"]),
-            fmt(s["uncouple_time"]), f"{s['rms_change_percent']:+.3f}", f"{s['min_distance']:.2f}",
+            name, s["function"], "yes" if s["coupled"] else "no", _number(s["couple_time"], "{:.2f}"),
+            _number(s["uncouple_time"], "{:.2f}"), _number(s["rms_change_percent"], "{:+.3f}"),
+            _number(s["min_distance"], "{:.2f}"),
         )  # fmt: skip
     return table
 
@@ -82,7 +86,7 @@ def run(
         trajectory = simulate(loaded, progress=lambda done, total: progress(scenario.name, done, total))
         progress.close()
         summary = write_run(trajectory, out)
-    except (ScenarioError, OutputError) as exc:
+    except (ScenarioError, OutputError, SimulationError) as exc:
         progress.close()
         _fail(str(exc))
     Console().print(_summary_table({loaded.name or scenario.stem: summary}))
@@ -99,7 +103,7 @@ def paper(
     progress = _LazyProgress()
     try:
         summaries, _ = run_paper(out, progress=progress)
-    except OutputError as exc:
+    except (OutputError, SimulationError) as exc:
         progress.close()
         _fail(str(exc))
     progress.close()

@@ -14,7 +14,16 @@ Transitions, checked once per step with ``r = |d|`` the pair measure::
 
 So a pair couples where it reaches the set distance, holds it, and after an
 uncouple command lets go at the first moment (9) holds; since the pair is then
-disarmed it does not couple again at once.  (9)'s second line, ``d_t < R +
+disarmed it does not couple again at once.
+
+Where the flag flips is a reading of the paper (``interaction.switch_at``):
+
+* ``"window"`` (default) — at the first step inside the window, the
+  literal (9).  A pair arriving from outside switches near
+  ``|d| = d_t + eps``, where (11)'s f1 and f2 differ by ``2 K_P eps``: a
+  small step in control (0.012 rad with the defaults).
+* ``"crossing"`` — at the step where ``|d|`` crosses ``d_t`` (still within
+  eps), the point where (11)'s f1 and f2 agree: no step in control.  (9)'s second line, ``d_t < R +
 R_j``, is a property of the scenario and is checked when it is validated.
 """
 
@@ -30,9 +39,12 @@ EVENT_COMMAND, EVENT_COUPLE, EVENT_UNCOUPLE = range(3)
 
 
 @numba.njit(cache=True)
-def next_flag(f_en, armed, r, d_t, eps):
-    """The pair flag after one check at pair measure ``r = |d|`` (see module text)."""
-    if abs(r - d_t) < eps:
+def next_flag(f_en, armed, r_before, r, d_t, eps, at_crossing):
+    """The pair flag after a step that took the pair measure from ``r_before`` to ``r`` (see module text)."""
+    reached = abs(r - d_t) < eps
+    if at_crossing:
+        reached = reached and (r_before - d_t) * (r - d_t) <= 0.0
+    if reached:
         if f_en == 0 and armed:
             return 1
         if f_en == 1 and not armed:

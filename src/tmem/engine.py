@@ -53,6 +53,10 @@ LARGE_SWARM = 64
 _LISTS_STALE = -1
 
 
+class SimulationError(ValueError):
+    """A run that could not be completed; the message is one line."""
+
+
 @dataclass(frozen=True)
 class Event:
     """A coupling transition, or an operator command (``agents`` empty for every pair)."""
@@ -134,9 +138,9 @@ class Trajectory:
 
 def _advance_source(
     k_start, k_stop, n_steps, record_every,
-    x, active, x_start, ad, bd, gains, function, couples, pair_function, k_p, reach, eps, c_max, box,
+    x, active, x_start, ad, bd, gains, function, couples, at_crossing, pair_function, k_p, reach, eps, c_max, box,
     use_lists, skin, nbr_ptr, nbr_idx, p_ref,
-    edge_i, edge_j, edge_dt, edge_dir, flag, armed, adj_ptr, adj_idx, edge_min, agent_min,
+    edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, adj_ptr, adj_idx, edge_min, agent_min,
     cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
     rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
     event_step, event_kind, event_i, event_j, event_action, n_events,
@@ -256,7 +260,8 @@ def _advance_source(
             dist = np.sqrt(dist2)
             if dist < edge_min[e]:
                 edge_min[e] = dist
-            new = coupling.next_flag(flag[e], armed[e], r, edge_dt[e], eps) if couples else flag[e]
+            new = coupling.next_flag(flag[e], armed[e], r_before[e], r, edge_dt[e], eps, at_crossing) if couples else flag[e]
+            r_before[e] = r
             if new != flag[e]:
                 flag[e] = new
                 event_step[n_events] = k
@@ -400,6 +405,7 @@ def simulate(
     adj_ptr, adj_idx = _partners(n_agents, edges)
     flag = setup.flag.copy()
     armed = np.ones(n_edges, dtype=np.int64)
+    r_before = np.full(n_edges, np.nan)  # |d| of each pair one step earlier; none before the first step
 
     method = scenario.neighbors.method
     use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
@@ -458,11 +464,11 @@ def simulate(
         k, next_command, next_record, n_events, status = advance(
             k, stop, n_steps, sim.record_every if record else 0,
             x, active, x_start, ad, bd, gains,
-            interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function),
+            interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function), ia.switch_at == "crossing",
             interaction.REPULSION if interaction.uses_coupling(ia.function) else interaction.FUNCTIONS.index(ia.function),
             gains[0], ia.reach, ia.eps, ia.c_max, setup.box,
             use_lists, scenario.neighbors.skin, nbr_ptr, nbr_idx, p_ref,
-            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, adj_ptr, adj_idx, edge_min, agent_min,
+            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, adj_ptr, adj_idx, edge_min, agent_min,
             cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
             rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
             event_step, event_kind, event_i, event_j, event_action, n_events,
@@ -476,6 +482,10 @@ def simulate(
         # Grow chunks towards about chunk_seconds each (the first includes compilation).
         chunk = int(min(max(chunk * 4, 1000), max(1000, chunk * chunk_seconds / max(elapsed, 1e-9))))
 
+    if not np.all(np.isfinite(x[active])):
+        raise SimulationError(
+            "the run diverged (non-finite agent states); check the model and controller values and dt"
+        )
     events = []
     for e in range(n_events):
         kind = coupling.EVENT_KINDS[event_kind[e]]

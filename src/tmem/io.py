@@ -32,8 +32,11 @@ _STATE_ATTRS = {
     "phi": ("tilt from the vertical", "rad"),
     "omega": ("tilt rate", "rad s-1"),
 }
-#: Files that mark a directory as tmem output, which a new run may replace.
-_OUTPUT_MARKERS = ("summary.json", "report.md")
+#: Everything tmem writes into an output directory; a directory holding only these may be replaced.
+OUTPUT_FILES = frozenset(
+    {"summary.json", "trajectory.nc", "velocity.png", "distance.png", "formation.png", "animation.gif", "report.md"}
+)
+OUTPUT_DIRECTORIES = frozenset({"fig5", "fig7", "fig9"})
 
 
 class OutputError(ValueError):
@@ -94,39 +97,85 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def _only_tmem_output(directory: Path) -> bool:
+    for entry in directory.iterdir():
+        if entry.is_symlink():
+            return False
+        if entry.is_dir():
+            if entry.name not in OUTPUT_DIRECTORIES or not _only_tmem_output(entry):
+                return False
+        elif entry.name not in OUTPUT_FILES:
+            return False
+    return True
+
+
 def check_output_directory(out: str | Path) -> Path:
-    """Refuse an ``out`` that exists and is not empty or an earlier tmem output."""
+    """Refuse an ``out`` that tmem may not replace; return it as a Path.
+
+    Allowed: a path that does not exist yet (under directories or nothing), an
+    empty directory, or one holding nothing but what tmem writes.  Refused: a
+    file, a symbolic link, the current directory or one containing it, a
+    directory holding anything else, a path below a file.
+    """
     out = Path(out)
+    if out.is_symlink():
+        raise OutputError(f"--out {out}: is a symbolic link; give the directory itself")
     if out.exists() and not out.is_dir():
         raise OutputError(f"--out {out}: exists and is not a directory")
-    if out.is_dir() and any(out.iterdir()) and not any((out / m).exists() for m in _OUTPUT_MARKERS):
-        raise OutputError(f"--out {out}: directory is not empty and holds no tmem output; choose another")
+    resolved = out.resolve()
+    if resolved == Path.cwd().resolve() or resolved in Path.cwd().resolve().parents:
+        raise OutputError(f"--out {out}: is the current directory or contains it; give a new subdirectory")
+    for parent in resolved.parents:
+        if parent.exists() and not parent.is_dir():
+            raise OutputError(f"--out {out}: {parent} is a file, not a directory")
+    if out.is_dir() and not _only_tmem_output(out):
+        raise OutputError(f"--out {out}: holds files tmem did not write; choose another directory")
     return out
 
 
 @contextmanager
 def atomic_directory(out: str | Path) -> Iterator[Path]:
-    """Yield a temporary directory that replaces ``out`` only if the block succeeds."""
+    """Yield a temporary directory that replaces ``out`` only if the block succeeds.
+
+    Parent directories made for it are removed again if the block fails.  File
+    system errors (no permission, disk full) become :class:`OutputError`.
+    """
     out = check_output_directory(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    missing = [p for p in reversed(out.absolute().parents) if not p.exists()]
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    except OSError as exc:
+        _remove_made(missing)
+        raise OutputError(f"--out {out}: cannot be written ({exc.strerror or exc})") from None
     try:
         yield tmp
-    except BaseException:
+        umask = os.umask(0)
+        os.umask(umask)
+        tmp.chmod(0o777 & ~umask)  # mkdtemp made it private
+        if out.exists():
+            shutil.rmtree(out)
+        tmp.rename(out)
+    except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
+        _remove_made(missing)
+        if isinstance(exc, OSError):
+            raise OutputError(f"--out {out}: cannot be written ({exc.strerror or exc})") from None
         raise
-    umask = os.umask(0)
-    os.umask(umask)
-    tmp.chmod(0o777 & ~umask)  # mkdtemp made it private
-    if out.exists():
-        shutil.rmtree(out)
-    tmp.rename(out)
+
+
+def _remove_made(directories: list[Path]) -> None:
+    for directory in reversed(directories):
+        try:
+            directory.rmdir()
+        except OSError:
+            return
 
 
 def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
     """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``."""
     summary = metrics.summarize(trajectory)
-    (directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    (directory / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
     to_dataset(trajectory).to_netcdf(directory / "trajectory.nc", engine="h5netcdf")
     plot.write_figures(trajectory, directory)
     return summary

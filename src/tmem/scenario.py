@@ -10,6 +10,7 @@ message naming the field and the reason.  Defaults are documented in
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from importlib import resources
@@ -30,10 +31,18 @@ class ScenarioError(ValueError):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    # strict: no quiet coercion of true to 1 or "6.0" to 6.0.
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
-Positive = Annotated[float, Field(gt=0)]
+#: Every number is bounded in magnitude, so that no product in the model overflows.
+LIMIT = 1e9
+Number = Annotated[float, Field(ge=-LIMIT, le=LIMIT)]
+Positive = Annotated[float, Field(gt=0, le=LIMIT)]
+NonNegative = Annotated[float, Field(ge=0, le=LIMIT)]
+Pair = Annotated[list[int], Field(min_length=2, max_length=2)]
+#: Most bytes a run may set aside for its records.
+MAX_RECORD_BYTES = 8 * 2**30
 
 
 class ModelParams(_Strict):
@@ -47,8 +56,8 @@ class ModelParams(_Strict):
 class ControllerParams(_Strict):
     """Roots (5) of the modal controller, Table 1."""
 
-    r_l: float = 12.0
-    im_l: Annotated[float, Field(ge=0)] = 0.1
+    r_l: Number = 12.0
+    im_l: NonNegative = 0.1
     im_r: Positive = 0.55
 
     @field_validator("r_l")
@@ -67,6 +76,7 @@ class InteractionParams(_Strict):
     c_max: Positive = 0.1
     d_t: Positive = 35.0
     eps: Positive = 0.2
+    switch_at: Literal["window", "crossing"] = "window"
 
     @property
     def reach(self) -> float:
@@ -85,7 +95,7 @@ class InteractionParams(_Strict):
 class SimulationParams(_Strict):
     """Time stepping and recording (``record_agents``: the agents recorded; all by default)."""
 
-    dt: Positive = 1e-4
+    dt: Annotated[float, Field(ge=1e-9, le=LIMIT)] = 1e-4
     duration: Positive = 60.0
     record_every: Annotated[int, Field(ge=1)] = 100
     record_agents: list[int] | None = None
@@ -95,9 +105,12 @@ class SimulationParams(_Strict):
         return int(round(self.duration / self.dt))
 
     @model_validator(mode="after")
-    def _at_least_one_step(self) -> "SimulationParams":
+    def _whole_steps(self) -> "SimulationParams":
         if self.dt > self.duration:
             raise _FieldError("dt", f"must not exceed duration = {self.duration:g} s, got {self.dt:g}")
+        steps = self.duration / self.dt
+        if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
+            raise _FieldError("duration", f"must be a whole number of steps dt = {self.dt:g} s, got {self.duration:g}")
         return self
 
 
@@ -131,10 +144,10 @@ class FormationParams(_Strict):
     n: Annotated[int, Field(ge=2)] | None = None
     d_t: Positive | None = None
     bearing: bool = False
-    edges: list[tuple[int, int] | tuple[int, int, Positive]] | None = None
-    center: list[float] | None = None
-    velocity: list[float] | None = None
-    jitter: Annotated[float, Field(ge=0)] = 0.0
+    edges: list[Annotated[list[int | float], Field(min_length=2, max_length=3)]] | None = None
+    center: list[Number] | None = None
+    velocity: list[Number] | None = None
+    jitter: NonNegative = 0.0
     seed: int = 0
     coupled: bool = True
 
@@ -164,10 +177,10 @@ class SwarmParams(_Strict):
     n: Annotated[int, Field(ge=2)]
     seed: int = 0
     region: list[Positive] | None = None
-    speed_rms: Annotated[float, Field(ge=0)] = 0.0
+    speed_rms: NonNegative = 0.0
 
 
-Vector = float | list[float]
+Vector = Number | list[Number]
 
 
 class Agent(_Strict):
@@ -188,10 +201,10 @@ class Command(_Strict):
     ``agent``.
     """
 
-    time: Annotated[float, Field(ge=0)]
+    time: NonNegative
     action: Literal["couple", "uncouple", "remove", "add"]
-    pair: tuple[int, int] | None = None
-    pairs: list[tuple[int, int]] | None = None
+    pair: Pair | None = None
+    pairs: list[Pair] | None = None
     agent: int | None = None
 
     @model_validator(mode="after")
@@ -209,7 +222,7 @@ class Command(_Strict):
         return self
 
     @property
-    def targets(self) -> list[tuple[int, int]] | None:
+    def targets(self) -> list[list[int]] | None:
         """The pairs a couple / uncouple command names; ``None`` for every pair."""
         if self.pair is not None:
             return [self.pair]
@@ -301,7 +314,21 @@ class Scenario(_Strict):
                 if not 0 <= a < n:
                     raise _FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
         self._check_commands(n)
+        self._check_record_size(n)
         return self
+
+    def _check_record_size(self, n: int) -> None:
+        sim = self.simulation
+        records = sim.n_steps // sim.record_every + 2
+        agents = n if sim.record_agents is None else len(sim.record_agents)
+        pairs = len(self.pairs())
+        size = records * (agents * (5 * self.space.axes * 8 + 1) + pairs * 32)
+        if size > MAX_RECORD_BYTES:
+            raise _FieldError(
+                "simulation.record_every",
+                f"the records would take {size / 2**30:.1f} GiB (at most {MAX_RECORD_BYTES / 2**30:g}); "
+                "record less often or fewer agents (record_agents)",
+            )
 
     def _check_sources(self) -> None:
         generated = self.formation is not None and self.formation.kind != "edges"
@@ -313,7 +340,15 @@ class Scenario(_Strict):
             raise _FieldError("agents", "no agents: give [[agents]], a [formation] or a [swarm]")
 
     def _check_agents(self, axes: int) -> None:
+        seen: dict[tuple, int] = {}
         for k, agent in enumerate(self.agents):
+            place = tuple(np.ravel(agent.position).tolist())
+            if place in seen:
+                raise _FieldError(
+                    f"agents[{k}].position",
+                    f"is the place of agents[{seen[place]}]: two agents at one point have no direction to part in",
+                )
+            seen[place] = k
             for name in ("position", "velocity", "tilt", "tilt_rate"):
                 value = getattr(agent, name)
                 if isinstance(value, list) and len(value) != axes:
@@ -340,6 +375,10 @@ class Scenario(_Strict):
             seen = set()
             for k, edge in enumerate(f.edges):
                 i, j = edge[:2]
+                if not (isinstance(i, int) and isinstance(j, int)):
+                    raise _FieldError(f"formation.edges[{k}]", f"needs two agent indices first, got {list(edge)}")
+                if len(edge) == 3 and not 0 < edge[2]:
+                    raise _FieldError(f"formation.edges[{k}]", f"d_t must be > 0, got {edge[2]}")
                 if not (0 <= i < n and 0 <= j < n) or i == j:
                     raise _FieldError(f"formation.edges[{k}]", f"needs two different agents in 0..{n - 1}, got {list(edge)}")
                 if len(edge) == 3 and edge[2] >= self.interaction.reach:
@@ -395,6 +434,14 @@ def _location(loc: tuple) -> str:
     return text
 
 
+_REWORDING = (
+    ("Input should be a valid dictionary or instance of", "must be a table, a"),
+    ("List should have", "must have"),
+    ("Input should be", "must be"),
+    (" after validation", ""),
+)
+
+
 def _explain(error: dict) -> str:
     where = _location(error["loc"])
     kind = error["type"]
@@ -410,8 +457,10 @@ def _explain(error: dict) -> str:
             where = f"{where}.{ctx_error.field}" if where else ctx_error.field
             reason = ctx_error.reason
         else:
-            reason = error["msg"].removeprefix("Value error, ").replace("Input should be", "must be")
-            if "input" in error and not isinstance(error["input"], dict | list):
+            reason = error["msg"].removeprefix("Value error, ")
+            for pydantic_words, ours in _REWORDING:
+                reason = reason.replace(pydantic_words, ours)
+            if "got" not in reason and "input" in error and not isinstance(error["input"], dict | list):
                 reason += f", got {error['input']!r}"
     return f"{where}: {reason}" if where else reason
 
@@ -497,7 +546,8 @@ def _toml_value(v) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        # A JSON string is a TOML basic string, given raw non-ASCII text and an escaped DEL.
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007F")
     if isinstance(v, float):
         return repr(v) if math.isfinite(v) else str(v)
     if isinstance(v, list | tuple):
