@@ -2,19 +2,27 @@
 
 The public API, in the order data flows::
 
-    scenario = tmem.load("examples/fig9.toml")     # or tmem.preset("fig9")
-    trajectory = tmem.simulate(scenario)           # engine: model, control, interaction, coupling
-    summary = tmem.summarize(trajectory)           # metrics: RMS velocity, events, distances
-    tmem.write_run(trajectory, "out/fig9")         # summary.json, trajectory.nc, figures
+    import tmem
+    from tmem.metrics import summarize
+    from tmem.io import write_run
+
+    scenario = tmem.load("examples/fig9.toml")   # or tmem.preset("fig9")
+    trajectory = tmem.simulate(scenario)         # engine: model, control, interaction, coupling
+    summary = summarize(trajectory)              # RMS velocity, events, distances, formation
+    write_run(trajectory, "out/fig9")            # summary.json, trajectory.nc, figures
 """
 
-from .control import interaction_point, modal_gains, printed_gains, roots
-from .engine import Event, Trajectory, simulate
-from .interaction import FUNCTIONS, attraction, improved_switching, repulsion, switching
-from .model import state_matrices, zero_order_hold
-from .scenario import Scenario, ScenarioError, load, loads, preset
-
 __version__ = "0.1.0"
+
+from . import _numba_cache  # noqa: E402
+
+_numba_cache.refresh()  # before any compiled function is loaded
+
+from .control import interaction_point, modal_gains, printed_gains, roots  # noqa: E402
+from .engine import Event, Trajectory, simulate  # noqa: E402
+from .interaction import FUNCTIONS, attraction, improved_switching, repulsion, switching  # noqa: E402
+from .model import state_matrices, zero_order_hold  # noqa: E402
+from .scenario import Scenario, ScenarioError, load, loads, preset  # noqa: E402
 
 __all__ = [
     "FUNCTIONS",

@@ -41,8 +41,8 @@ REPULSION, ATTRACTION, SWITCHING, IMPROVED = range(4)
 
 
 def uses_coupling(function: str) -> bool:
-    """True for the functions that switch on the pair flag ``F_en``."""
-    return FUNCTIONS.index(function) >= SWITCHING
+    """True for the functions that switch on the pair flag ``F_en``: (10) and (11)."""
+    return function in ("switching", "improved")
 
 
 @numba.njit(cache=True)
@@ -55,45 +55,46 @@ def _sign(d: float) -> float:
     return (d > 0.0) - (d < 0.0)
 
 
+@numba.njit(cache=True)
+def _overlap(d: float, k_p: float, reach: float) -> float:
+    """``K_P c`` with ``c = d - s_d reach`` (7): the push of (8) inside the spheres, 0 outside."""
+    return k_p * (d - _sign(d) * reach) if abs(d) < reach else 0.0
+
+
+@numba.njit(cache=True)
+def _spring(d: float, k_p: float, d_t: float) -> float:
+    """``K_P (d - s_d d_t)``: apart closer than ``d_t``, together farther."""
+    return k_p * (d - _sign(d) * d_t)
+
+
 @numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)
 def repulsion(d, k_p, reach, c_max):
     """Repulsion (8): ``K_P (d - s_d reach)`` for ``|d| < reach``, else 0; saturated."""
-    if abs(d) >= reach:
-        return 0.0
-    return _saturate(k_p * (d - _sign(d) * reach), c_max)
+    return _saturate(_overlap(d, k_p, reach), c_max)
 
 
 @numba.vectorize(["float64(float64, float64, float64, float64, float64)"], cache=True)
 def attraction(d, k_p, reach, d_t, c_max):
     """Attraction (Fig. 3): ``K_P (d - s_d d_t)`` for ``|d| < reach``, else 0; saturated."""
-    if abs(d) >= reach:
-        return 0.0
-    return _saturate(k_p * (d - _sign(d) * d_t), c_max)
+    return _saturate(_spring(d, k_p, d_t), c_max) if abs(d) < reach else 0.0
 
 
 @numba.vectorize(["float64(float64, int64, float64, float64, float64, float64)"], cache=True)
 def switching(d, f_en, k_p, reach, d_t, c_max):
-    """Switching (10): repulsion (8) if ``f_en == 0``, else ``K_P (d - s_d d_t)``; saturated."""
-    if f_en == 0:
-        if abs(d) >= reach:
-            return 0.0
-        return _saturate(k_p * (d - _sign(d) * reach), c_max)
-    return _saturate(k_p * (d - _sign(d) * d_t), c_max)
+    """Switching (10): f1 = repulsion (8) if ``f_en == 0``, else f2 = ``K_P (d - s_d d_t)``; saturated."""
+    return _saturate(_overlap(d, k_p, reach) if f_en == 0 else _spring(d, k_p, d_t), c_max)
 
 
 @numba.vectorize(["float64(float64, int64, float64, float64, float64, float64)"], cache=True)
 def improved_switching(d, f_en, k_p, reach, d_t, c_max):
     """Improved switching (11): the continuous f1 if ``f_en == 0``, else f2; saturated."""
     r = abs(d)
-    s = _sign(d)
     if f_en != 0 or r < d_t:
-        u = k_p * (d - s * d_t)
-    elif r >= reach:
-        u = 0.0
+        u = _spring(d, k_p, d_t)
     elif r <= 0.5 * (d_t + reach):
-        u = -k_p * (d - s * d_t)
+        u = -_spring(d, k_p, d_t)
     else:
-        u = k_p * (d - s * reach)
+        u = _overlap(d, k_p, reach)
     return _saturate(u, c_max)
 
 
