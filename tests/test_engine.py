@@ -99,9 +99,9 @@ def test_couple_command_rearms_a_released_pair():
     kinds = [e.kind for e in tr.events]
     assert kinds[:4] == ["couple", "command", "uncouple", "command"]
     assert tr.events[1].agents == ()  # a command to every pair
-    # Released at ~d_t and pushed apart, the pair is no longer at d_t when re-armed, so it stays
-    # uncoupled unless it comes back to d_t; either way the flag follows the events.
-    assert tr.flag[-1, 0] == (1 if kinds[-1] == "couple" else 0)
+    # Re-armed at 15 s while still in the spheres, the pair couples again when it next reaches d_t.
+    assert kinds[4] == "couple" and 15.0 < tr.events[4].time < 25.0
+    assert tr.flag[-1, 0] == 1
 
 
 def test_three_agents_on_a_line_interact_pairwise():
