@@ -86,6 +86,70 @@ def test_bad_scenario_is_refused_with_one_line(case, tmp_path, runner):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]  # nothing half-written beside it
 
 
+SWARM = """
+[space]
+axes = 2
+[interaction]
+function = "improved"
+[formation]
+kind = "hex"
+n = 7
+"""
+
+SWARM_CASES = {
+    "formation with repulsion": (SWARM.replace('"improved"', '"repulsion"'), "formation", "'switching' (10) or"),
+    "formation without n": (SWARM.replace("n = 7", ""), "formation.n", "is required"),
+    "ring of two": (SWARM.replace('"hex"', '"ring"').replace("n = 7", "n = 2"), "formation.n", "at least 3"),
+    "planar formation on one axis": (SWARM.replace("axes = 2", "axes = 1"), "formation.kind", "2 or 3 axes"),
+    "formation d_t beyond reach": (SWARM + "d_t = 41.0\n", "formation.d_t", "less than R + R_j"),
+    "velocity of the wrong size": (SWARM + "velocity = [1.0, 2.0, 3.0]\n", "formation.velocity", "needs 2 values"),
+    "agents and a formation": (SWARM + "[[agents]]\nposition = [0.0, 0.0]\n", "formation", "give the agents once"),
+    "edge to a missing agent": (
+        SWARM.replace('kind = "hex"\nn = 7', 'kind = "edges"\nedges = [[0, 5]]')
+        + "[[agents]]\nposition = [0.0, 0.0]\n[[agents]]\nposition = [30.0, 0.0]\n",
+        "formation.edges[0]", "two different agents in 0..1",
+    ),
+    "repeated edge": (
+        SWARM.replace('kind = "hex"\nn = 7', 'kind = "edges"\nedges = [[0, 1], [1, 0]]')
+        + "[[agents]]\nposition = [0.0, 0.0]\n[[agents]]\nposition = [30.0, 0.0]\n",
+        "formation.edges[1]", "repeats the pair",
+    ),
+    "command on a non-pair": (SWARM + '[[commands]]\ntime = 1.0\naction = "uncouple"\npair = [1, 4]\n',
+                              "commands[0].pair", "not a formation pair"),
+    "remove an agent twice": (
+        SWARM + '[[commands]]\ntime = 1.0\naction = "remove"\nagent = 2\n'
+        '[[commands]]\ntime = 2.0\naction = "remove"\nagent = 2\n',
+        "commands[1].agent", "not flying",
+    ),
+    "add a flying agent": (SWARM + '[[commands]]\ntime = 1.0\naction = "add"\nagent = 2\n', "commands[0].agent",
+                           "already flying"),
+    "remove without agent": (SWARM + '[[commands]]\ntime = 1.0\naction = "remove"\n', "commands[0].agent",
+                             "is required"),
+    "record an agent out of range": (SWARM + "[simulation]\nrecord_agents = [0, 9]\n",
+                                     "simulation.record_agents[1]", "outside 0..6"),
+    "periodic without a box": ("[space]\naxes = 2\nperiodic = true\n[swarm]\nn = 10\n", "space.box", "is required"),
+    "swarm without a region": ("[space]\naxes = 2\n[swarm]\nn = 10\n", "swarm.region", "is required"),
+    "2-D agent given one number": ("[space]\naxes = 2\n[[agents]]\nposition = 1.0\n[[agents]]\nposition = [5.0, 0.0]\n",
+                                   "agents[0].position", "list of 2 values"),
+    "no agents at all": ("[space]\naxes = 2\n", "agents", "no agents"),
+    "every pair in a big swarm": ("[space]\naxes = 2\nperiodic = true\nbox = [1e4, 1e4]\n"
+                                  '[interaction]\nfunction = "improved"\n[swarm]\nn = 3000\n',
+                                  "interaction.function", "give a [formation]"),
+}
+
+
+@pytest.mark.parametrize("case", SWARM_CASES, ids=list(SWARM_CASES))
+def test_bad_swarm_scenario_is_refused_with_one_line(case, tmp_path, runner):
+    text, field, reason = SWARM_CASES[case]
+    scenario = tmp_path / "bad.toml"
+    scenario.write_text(text)
+    result = runner.invoke(app, ["run", str(scenario), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and field in lines[0] and reason in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
 def test_missing_file(tmp_path, runner):
     result = runner.invoke(app, ["run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "out")])
     assert result.exit_code == 2

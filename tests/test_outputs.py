@@ -96,7 +96,3 @@ def test_paper_command_writes_three_runs_and_the_report(tmp_path):
             assert f"F_en drops at {s['uncouple_time']:.2f} s" in report
     assert "≈ 5.6 %" in report and "≈ 0.2 %" in report
 
-
-@pytest.mark.parametrize("name", tmem.scenario.PRESETS)
-def test_examples_are_the_shipped_presets(name):
-    assert tmem.load(EXAMPLES / f"{name}.toml") == tmem.preset(name)

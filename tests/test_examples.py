@@ -1,0 +1,29 @@
+"""Every shipped example loads and runs; the swarm examples briefly."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tmem
+from tmem.metrics import summarize
+from tmem.scenario import with_changes
+
+EXAMPLES = Path(__file__).parent.parent / "examples"
+SWARM = sorted((EXAMPLES / "swarm").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", SWARM, ids=[p.stem for p in SWARM])
+def test_swarm_example_runs(path):
+    scenario = tmem.load(path)
+    short = with_changes(scenario, {"simulation.duration": 5.0, "commands": []})
+    s = summarize(tmem.simulate(short))
+    assert s["agents"] == scenario.n_agents
+    assert np.isfinite(s["rms_velocity_final"])
+    if scenario.formation is not None and scenario.formation.coupled:
+        assert s["formation"]["distance_error"]["max"] < 2.0
+
+
+@pytest.mark.parametrize("name", tmem.scenario.PRESETS)
+def test_examples_are_the_shipped_presets(name):
+    assert tmem.load(EXAMPLES / f"{name}.toml") == tmem.preset(name)
