@@ -1,4 +1,4 @@
-"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``.
+"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` a run.
 
 User mistakes (a bad scenario, an unusable output directory) end with one
 line on standard error naming the field and the reason, exit status 2 and no
@@ -110,6 +110,23 @@ def paper(
     progress.close()
     Console().print(_summary_table(summaries))
     Console().print(f"report: {out / 'report.md'}")
+
+
+@app.command("animate")
+def animate_command(
+    run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run` (2-D runs)."),
+    out: Path = typer.Option(None, "--out", "-o", help="Animation file (.gif, or .mp4 with ffmpeg); default RUN_DIR/animation.gif."),
+    fps: int = typer.Option(20, help="Frames per second."),
+    max_frames: int = typer.Option(400, help="Most frames; the recorded times are thinned evenly."),
+) -> None:
+    """Animate a 2-D run: agents, interaction circles, coupled pairs and a clock."""
+    from .animate import animate
+
+    try:
+        path = animate(run_dir, out, fps=fps, max_frames=max_frames)
+    except (ValueError, OSError) as exc:
+        _fail(str(exc))
+    Console().print(f"written {path}")
 
 
 def main() -> None:
