@@ -82,16 +82,19 @@ def test_verlet_lists_match_brute_force(axes, periodic):
     active = rng.uniform(size=n) > 0.1
     box = np.full(axes, side) if periodic else np.zeros(axes)
     ptr = np.zeros(n + 1, dtype=np.int64)
-    need = verlet_lists(points, active, cutoff, box, ptr, np.empty(0, dtype=np.int32))
+    order = np.empty(n, dtype=np.int64)
+    need, _ = verlet_lists(points, active, cutoff, box, ptr, np.empty(0, dtype=np.int32), order)
     idx = np.empty(need, dtype=np.int32)
-    verlet_lists(points, active, cutoff, box, ptr, idx)
+    _, slots = verlet_lists(points, active, cutoff, box, ptr, idx, order)
+    assert sorted(order[:slots].tolist()) == np.flatnonzero(active).tolist()  # each active agent once
     delta = points[None, :, :] - points[:, None, :]
     if periodic:
         delta -= side * np.round(delta / side)
     close = (np.linalg.norm(delta, axis=2) < cutoff) & active[None, :] & active[:, None]
     np.fill_diagonal(close, False)
-    for i in range(n):
-        assert idx[ptr[i] : ptr[i + 1]].tolist() == np.flatnonzero(close[i]).tolist()
+    for s in range(slots):
+        neighbours = order[idx[ptr[s] : ptr[s + 1]]]
+        assert neighbours.tolist() == np.flatnonzero(close[order[s]]).tolist()
 
 
 def test_periodic_gas_keeps_momentum_and_stays_in_the_box():

@@ -139,7 +139,7 @@ class Trajectory:
 def _advance_source(
     k_start, k_stop, n_steps, record_every,
     x, active, x_start, ad, bd, gains, function, couples, at_crossing, pair_function, k_p, reach, eps, c_max, box,
-    use_lists, skin, nbr_ptr, nbr_idx, p_ref,
+    use_lists, skin, nbr_ptr, nbr_idx, order, n_slots, p_ref,
     edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, adj_ptr, adj_idx, edge_min, agent_min,
     cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
     rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
@@ -148,6 +148,8 @@ def _advance_source(
     n_agents, n_axes, _ = x.shape
     n_edges = edge_i.shape[0]
     p_star = np.empty((n_agents, n_axes))
+    slot_p_star = np.empty((n_slots, n_axes))  # P* and positions in slot order: neighbours close in memory
+    slot_position = np.empty((n_slots, n_axes))
     u = np.zeros((n_agents, n_axes))
     moved = np.zeros(n_agents)
     d = np.empty(n_axes)
@@ -197,26 +199,32 @@ def _advance_source(
         if use_lists and (rebuild or np.sqrt(moved.max()) > 0.5 * skin):
             # The caller builds the lists (with p_ref = P* now) and resumes at step k.
             return k, next_command, next_record, n_events, _LISTS_STALE
-        # 3. non-formation neighbours
-        for i in numba.prange(n_agents):
+        # 3. non-formation neighbours, agent by agent in slot order
+        for q in numba.prange(n_slots):
+            i = order[q]
+            for a in range(n_axes):
+                slot_p_star[q, a] = p_star[i, a]
+                slot_position[q, a] = x[i, a, 0]
+        for q in numba.prange(n_slots):
+            i = order[q]
             u0 = 0.0
             u1 = 0.0
             u2 = 0.0
             if active[i]:
-                for q in range(nbr_ptr[i], nbr_ptr[i + 1]):
-                    j = nbr_idx[q]
+                for entry in range(nbr_ptr[q], nbr_ptr[q + 1]):
+                    t = nbr_idx[entry]
+                    j = order[t]
                     if not active[j]:
                         continue
-                    r2 = 0.0
-                    d0 = nearest_image(p_star[j, 0] - p_star[i, 0], box[0])
+                    d0 = nearest_image(slot_p_star[t, 0] - slot_p_star[q, 0], box[0])
                     r2 = d0 * d0
                     d1 = 0.0
                     d2 = 0.0
                     if n_axes > 1:
-                        d1 = nearest_image(p_star[j, 1] - p_star[i, 1], box[1])
+                        d1 = nearest_image(slot_p_star[t, 1] - slot_p_star[q, 1], box[1])
                         r2 += d1 * d1
                     if n_axes > 2:
-                        d2 = nearest_image(p_star[j, 2] - p_star[i, 2], box[2])
+                        d2 = nearest_image(slot_p_star[t, 2] - slot_p_star[q, 2], box[2])
                         r2 += d2 * d2
                     if r2 >= reach2 or r2 == 0.0:
                         continue
@@ -228,7 +236,7 @@ def _advance_source(
                         continue
                     dist2 = 0.0
                     for a in range(n_axes):
-                        delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
+                        delta = nearest_image(slot_position[t, a] - slot_position[q, a], box[a])
                         dist2 += delta * delta
                     if dist2 < agent_min[i]:
                         agent_min[i] = dist2
@@ -412,8 +420,10 @@ def simulate(
     if use_lists:
         nbr_ptr = np.zeros(n_agents + 1, dtype=np.int64)
         nbr_idx = np.empty(16 * n_agents, dtype=np.int32)
+        order = np.empty(n_agents, dtype=np.int64)
     else:
-        nbr_ptr, nbr_idx = all_pairs(n_agents)
+        nbr_ptr, nbr_idx, order = all_pairs(n_agents)
+    n_slots = n_agents
     advance = _advance_threaded if n_agents >= LARGE_SWARM else _advance_serial
 
     cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt)
@@ -440,20 +450,20 @@ def simulate(
     p_ref = np.zeros((n_agents, n_axes))
     builds = 0
 
-    def build_lists(nbr_idx: np.ndarray) -> np.ndarray:
-        """Build the neighbour lists from the agents' P* now; returns the (possibly grown) index array."""
+    def build_lists(nbr_idx: np.ndarray) -> tuple[np.ndarray, int]:
+        """Build the neighbour lists from the agents' P* now; returns the (possibly grown) index array and slots."""
         nonlocal builds
         p_ref[:] = x @ (gains / gains[0])
         cutoff = ia.reach + scenario.neighbors.skin
-        needed = verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
+        needed, slots = verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx, order)
         if needed > len(nbr_idx):
             nbr_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
-            verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx)
+            verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx, order)
         builds += 1
-        return nbr_idx
+        return nbr_idx, slots
 
     if use_lists:
-        nbr_idx = build_lists(nbr_idx)
+        nbr_idx, n_slots = build_lists(nbr_idx)
 
     next_command = next_record = n_events = 0
     k = 0
@@ -467,14 +477,14 @@ def simulate(
             interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function), ia.switch_at == "crossing",
             interaction.REPULSION if interaction.uses_coupling(ia.function) else interaction.FUNCTIONS.index(ia.function),
             gains[0], ia.reach, ia.eps, ia.c_max, setup.box,
-            use_lists, scenario.neighbors.skin, nbr_ptr, nbr_idx, p_ref,
+            use_lists, scenario.neighbors.skin, nbr_ptr, nbr_idx, order, n_slots, p_ref,
             edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, adj_ptr, adj_idx, edge_min, agent_min,
             cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
             rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
             event_step, event_kind, event_i, event_j, event_action, n_events,
         )  # fmt: skip
         if status == _LISTS_STALE:  # build the neighbour lists and go on from the same step
-            nbr_idx = build_lists(nbr_idx)
+            nbr_idx, n_slots = build_lists(nbr_idx)
             continue
         elapsed = _time.perf_counter() - started
         if progress is not None:

@@ -20,12 +20,13 @@ import numba
 import numpy as np
 
 
-def all_pairs(n_agents: int) -> tuple[np.ndarray, np.ndarray]:
-    """Rows listing, for every agent, every other agent: ``(ptr, idx)``."""
+def all_pairs(n_agents: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rows listing, for every agent, every other agent: ``(ptr, idx, order)`` with ``order`` the identity."""
     idx = np.empty(n_agents * (n_agents - 1), dtype=np.int32)
     for i in range(n_agents):
         idx[i * (n_agents - 1) : (i + 1) * (n_agents - 1)] = np.delete(np.arange(n_agents), i)
-    return np.arange(0, n_agents * (n_agents - 1) + 1, n_agents - 1, dtype=np.int64), idx
+    ptr = np.arange(0, n_agents * (n_agents - 1) + 1, n_agents - 1, dtype=np.int64)
+    return ptr, idx, np.arange(n_agents, dtype=np.int64)
 
 
 @numba.njit(cache=True)
@@ -94,74 +95,75 @@ def _cells(points, active, cutoff, box):
     return cell_of, shape, start, order
 
 
-@numba.njit(cache=True)
-def _cell_coords(c, shape, coords):
-    for a in range(shape.shape[0] - 1, -1, -1):
-        coords[a] = c % shape[a]
-        c //= shape[a]
-
-
 @numba.njit(cache=True, parallel=True)
-def verlet_lists(points, active, cutoff, box, ptr, idx):
-    """Fill ``(ptr, idx)`` with, for each active agent, the active agents within ``cutoff``.
+def verlet_lists(points, active, cutoff, box, ptr, idx, order):
+    """Verlet lists over *slots*: the active agents sorted by cell.
 
-    Returns the number of entries needed.  If it exceeds ``len(idx)`` nothing
-    is filled in ``idx`` and the caller must grow it and call again.
+    Fills ``order[:m]`` with the agents in cell order (``m`` active agents) and,
+    for each slot ``s``, row ``ptr[s]:ptr[s + 1]`` of ``idx`` with the slots of
+    the agents within ``cutoff`` of agent ``order[s]``, sorted by agent index.
+    Neighbours in one cell grid are then close in memory.  Returns ``(needed,
+    m)``; if ``needed`` exceeds ``len(idx)`` the rows are not filled and the
+    caller must grow ``idx`` and call again.
     """
     n, axes = points.shape
-    cell_of, shape, start, order = _cells(points, active, cutoff, box)
+    cell_of, shape, start, cells_order = _cells(points, active, cutoff, box)
+    m = cells_order.shape[0]
+    order[:m] = cells_order
     cutoff2 = cutoff * cutoff
-    n_offsets = 3**axes
-    count = np.zeros(n, dtype=np.int64)
+    s1 = shape[1] if axes > 1 else 1
+    s2 = shape[2] if axes > 2 else 1
+    count = np.zeros(m, dtype=np.int64)
     for fill in range(2):
         if fill == 1:
             ptr[0] = 0
-            for i in range(n):
-                ptr[i + 1] = ptr[i] + count[i]
-            if ptr[n] > idx.shape[0]:
-                return ptr[n]
-        for i in numba.prange(n):
-            if cell_of[i] < 0:
-                continue
-            home = np.empty(axes, dtype=np.int64)
-            other = np.empty(axes, dtype=np.int64)
-            _cell_coords(cell_of[i], shape, home)
+            for s in range(m):
+                ptr[s + 1] = ptr[s] + count[s]
+            if ptr[m] > idx.shape[0]:
+                return ptr[m], m
+        for s in numba.prange(m):
+            i = cells_order[s]
+            c = cell_of[i]
+            h0 = c // (s1 * s2)
+            h1 = (c // s2) % s1
+            h2 = c % s2
             found = 0
-            for o in range(n_offsets):
-                code = o
-                c = 0
-                inside = True
-                for a in range(axes):
-                    step = code % 3 - 1
-                    code //= 3
-                    if shape[a] == 1 and step != 0:
-                        inside = False  # a single cell along this axis holds every neighbour already
-                        break
-                    k = home[a] + step
-                    if box[a] > 0.0:
-                        k %= shape[a]
-                    elif k < 0 or k >= shape[a]:
-                        inside = False
-                        break
-                    other[a] = k
-                    c = c * shape[a] + k
-                if not inside:
+            for o0 in range(-1, 2) if shape[0] > 1 else range(0, 1):
+                k0 = h0 + o0
+                if box[0] > 0.0:
+                    k0 %= shape[0]
+                elif k0 < 0 or k0 >= shape[0]:
                     continue
-                for s in range(start[c], start[c + 1]):
-                    j = order[s]
-                    if j == i:
+                for o1 in range(-1, 2) if s1 > 1 else range(0, 1):
+                    k1 = h1 + o1
+                    if axes > 1 and box[1] > 0.0:
+                        k1 %= s1
+                    elif k1 < 0 or k1 >= s1:
                         continue
-                    r2 = 0.0
-                    for a in range(axes):
-                        delta = nearest_image(points[j, a] - points[i, a], box[a])
-                        r2 += delta * delta
-                    if r2 < cutoff2:
-                        if fill == 1:
-                            idx[ptr[i] + found] = j
-                        found += 1
+                    for o2 in range(-1, 2) if s2 > 1 else range(0, 1):
+                        k2 = h2 + o2
+                        if axes > 2 and box[2] > 0.0:
+                            k2 %= s2
+                        elif k2 < 0 or k2 >= s2:
+                            continue
+                        cell = (k0 * s1 + k1) * s2 + k2
+                        for t in range(start[cell], start[cell + 1]):
+                            j = cells_order[t]
+                            if j == i:
+                                continue
+                            r2 = 0.0
+                            for a in range(axes):
+                                delta = nearest_image(points[j, a] - points[i, a], box[a])
+                                r2 += delta * delta
+                            if r2 < cutoff2:
+                                if fill == 1:
+                                    # insertion into the row, kept sorted by agent index
+                                    q = ptr[s] + found
+                                    while q > ptr[s] and cells_order[idx[q - 1]] > j:
+                                        idx[q] = idx[q - 1]
+                                        q -= 1
+                                    idx[q] = t
+                                found += 1
             if fill == 0:
-                count[i] = found
-            else:  # sort the row: contributions are then summed in index order
-                row = idx[ptr[i] : ptr[i] + found]
-                row.sort()
-    return ptr[n]
+                count[s] = found
+    return ptr[m], m
