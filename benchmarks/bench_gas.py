@@ -27,6 +27,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import platform
@@ -126,7 +127,11 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=STEPS)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--skin", type=float, default=4.0, help="Verlet skin, m")
-    parser.add_argument("--jaxmd-python", default=None, help="a Python with jax-md, to run the same cases")
+    parser.add_argument(
+        "--jaxmd-python",
+        default=sys.executable if importlib.util.find_spec("jax_md") else None,
+        help="a Python with jax-md, to run the same cases (default: this one, if it has jax-md)",
+    )
     parser.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = parser.parse_args()
 
