@@ -59,7 +59,7 @@ class SimulationError(ValueError):
 
 @dataclass(frozen=True)
 class Event:
-    """A coupling transition, or an operator command (``agents`` empty for every pair)."""
+    """A coupling transition, or an operator command (``agents`` empty for several or every pair)."""
 
     time: float
     kind: str  # "command" | "couple" | "uncouple"

@@ -139,7 +139,7 @@ def direction_error_deg(trajectory: Trajectory) -> float | None:
 
 
 def summarize_events(events: list[Event]) -> list[dict]:
-    """Events as JSON-ready dicts; ``agents`` is ``[]`` for a command to every pair."""
+    """Events as JSON-ready dicts; ``agents`` is ``[]`` for a command to several or every pair."""
     rows = []
     for e in events:
         row = {"time": e.time, "kind": e.kind, "agents": list(e.agents)}
