@@ -118,7 +118,7 @@ def jaxmd(python: str, ns: list[int], steps: int, repeat: int) -> dict[int, dict
     )  # fmt: skip
     data = json.loads(out.read_text())
     out.unlink()
-    return {int(row["n"]): row for row in data["results"]}
+    return {int(row["n"]): row for row in data["cases"]}
 
 
 def main() -> None:

@@ -1,0 +1,115 @@
+"""Animation of a 2-D run, from small synthetic ``trajectory.nc`` files."""
+
+import matplotlib.animation
+import numpy as np
+import pytest
+import xarray as xr
+from PIL import Image, ImageChops
+
+from tmem.animate import _load, animate
+
+SCENARIO = 'name = "synthetic"\n\n[interaction]\nradius = 20.0\nd_t = 35.0\n'
+
+
+def _dataset(n_times=30, n_axes=2, agents=(0, 1, 2), pairs=((0, 1),), active=True, d_t=True):
+    """Agents on straight lines, the pairs coupling halfway, the last agent removed at two thirds."""
+    n = len(agents)
+    time = 0.5 * np.arange(n_times)
+    start = np.array([[0.0, 0.0, 0.0], [80.0, 10.0, 0.0], [40.0, -50.0, 0.0]] * n)[:n, :n_axes]
+    velocity = np.array([[2.0, 0.5, 0.0], [-2.0, 0.0, 0.0], [0.0, 1.0, 0.0]] * n)[:n, :n_axes]
+    P = start + time[:, None, None] * velocity
+    pairs = np.array(pairs, dtype=int).reshape(-1, 2)
+    flag = np.zeros((n_times, len(pairs)), np.int8)
+    flag[n_times // 2 :] = 1
+    zeros = np.zeros_like(P)
+    data = {name: (("time", "agent", "axis"), value) for name, value in (("P", P), ("V", zeros), ("U", zeros))}
+    data["F_en"] = (("time", "pair"), flag)
+    if active:
+        alive = np.ones((n_times, n), np.int8)
+        alive[2 * n_times // 3 :, n - 1] = 0
+        data["active"] = (("time", "agent"), alive)
+    if d_t:
+        data["d_t"] = ("pair", np.full(len(pairs), 35.0))
+    coords = {
+        "time": ("time", time, {"units": "s"}),
+        "agent": np.asarray(agents),
+        "axis": ["x", "y", "z"][:n_axes],
+        "pair": np.arange(len(pairs)),
+        "pair_i": ("pair", pairs[:, 0]),
+        "pair_j": ("pair", pairs[:, 1]),
+    }
+    return xr.Dataset(data, coords=coords, attrs={"scenario": SCENARIO})
+
+
+def _write(tmp_path, **kwargs):
+    _dataset(**kwargs).to_netcdf(tmp_path / "trajectory.nc", engine="h5netcdf")
+    return tmp_path
+
+
+def _frames(path):
+    with Image.open(path) as gif:
+        frames = []
+        for k in range(gif.n_frames):
+            gif.seek(k)
+            frames.append(gif.convert("RGB"))
+        return frames
+
+
+@pytest.mark.parametrize("max_frames, expected", [(400, 30), (7, 7)])
+def test_gif_has_one_frame_per_time_up_to_max_frames(tmp_path, max_frames, expected):
+    run = _write(tmp_path)
+    out = animate(run, max_frames=max_frames, dpi=40)
+    assert out == run / "animation.gif"
+    frames = _frames(out)
+    assert len(frames) == expected
+    assert ImageChops.difference(frames[0], frames[-1]).getbbox() is not None
+
+
+def test_gas_without_pairs_active_or_d_t(tmp_path):
+    run = _write(tmp_path, pairs=(), active=False, d_t=False)
+    out = animate(run, out=tmp_path / "sub" / "gas.gif", max_frames=5, dpi=40)
+    assert len(_frames(out)) == 5
+
+
+def test_recorded_subset_maps_pairs_by_agent_index(tmp_path):
+    # Agents 7, 3, 5 recorded; the pair with agent 9 (not recorded) is left out.
+    run = _write(tmp_path, agents=(7, 3, 5), pairs=((3, 7), (5, 9), (7, 5)))
+    drawn = _load(run, max_frames=10)
+    assert drawn.col_i.tolist() == [1, 0] and drawn.col_j.tolist() == [0, 2]
+    assert drawn.flag.shape == (10, 2)
+    assert drawn.d_t.tolist() == [35.0, 35.0]
+    assert not drawn.active[-1, 2] and drawn.active[0].all()
+    assert len(_frames(animate(run, max_frames=10, dpi=40))) == 10
+
+
+@pytest.mark.parametrize("n_axes, words", [(1, "1 axis"), (3, "3 axes")])
+def test_refuses_runs_that_are_not_2d(tmp_path, n_axes, words):
+    run = _write(tmp_path, n_axes=n_axes)
+    with pytest.raises(ValueError) as error:
+        animate(run)
+    assert str(error.value) == f"animate: the run has {words}; only 2-D runs can be animated"
+    assert not (run / "animation.gif").exists()
+
+
+def test_missing_trajectory(tmp_path):
+    with pytest.raises(ValueError, match="animate: no trajectory.nc in"):
+        animate(tmp_path)
+
+
+def test_mp4_without_ffmpeg(tmp_path, monkeypatch):
+    monkeypatch.setattr(matplotlib.animation.writers, "is_available", lambda name: False)
+    run = _write(tmp_path)
+    with pytest.raises(ValueError) as error:
+        animate(run, out=tmp_path / "run.mp4")
+    assert str(error.value) == "animate: writing MP4 needs ffmpeg; write a .gif instead"
+
+
+@pytest.mark.skipif(not matplotlib.animation.writers.is_available("ffmpeg"), reason="ffmpeg not installed")
+def test_mp4_with_ffmpeg(tmp_path):
+    out = animate(_write(tmp_path), out=tmp_path / "run.mp4", max_frames=10, dpi=40)
+    assert out.stat().st_size > 0
+
+
+def test_unknown_format(tmp_path):
+    with pytest.raises(ValueError, match="name a .gif or .mp4 file"):
+        animate(_write(tmp_path), out=tmp_path / "run.png")
