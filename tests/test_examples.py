@@ -27,3 +27,18 @@ def test_swarm_example_runs(path):
 @pytest.mark.parametrize("name", tmem.scenario.PRESETS)
 def test_examples_are_the_shipped_presets(name):
     assert tmem.load(EXAMPLES / f"{name}.toml") == tmem.preset(name)
+
+
+ALL = sorted(EXAMPLES.rglob("*.toml"))
+
+
+@pytest.mark.parametrize("path", ALL, ids=[p.stem for p in ALL])
+def test_scenario_survives_its_own_toml(path):
+    """The TOML stored in trajectory.nc loads back to the same scenario."""
+    scenario = tmem.load(path)
+    assert tmem.loads(scenario.to_toml()) == scenario
+
+
+def test_awkward_names_survive_toml():
+    scenario = with_changes(tmem.preset("fig9"), {"name": 'two\nlines, "quotes", \\ é 😀 \x7f'})
+    assert tmem.loads(scenario.to_toml()) == scenario
