@@ -11,18 +11,9 @@ import pytest
 
 import tmem
 from tmem.reference import final_state, integrate
-from tmem.scenario import Scenario, from_dict
+from tmem.scenario import Scenario, from_dict, with_changes
 
 DTS = (1e-2, 1e-3, 1e-4, 1e-5)
-
-
-def with_changes(scenario: Scenario, dt: float | None = None, agents: list[dict] | None = None) -> Scenario:
-    data = scenario.model_dump()
-    if dt is not None:
-        data["simulation"]["dt"] = dt
-    if agents is not None:
-        data["agents"] = agents
-    return from_dict(data)
 
 
 def three_agents() -> Scenario:
@@ -32,7 +23,7 @@ def three_agents() -> Scenario:
         {"position": 45.0, "velocity": 0.0},
         {"position": 100.0, "velocity": -2.0},
     ]
-    return with_changes(tmem.preset("repulsion"), agents=agents)
+    return with_changes(tmem.preset("repulsion"), {"agents": agents})
 
 
 SCENARIOS = {
@@ -46,7 +37,7 @@ SCENARIOS = {
 def study(request) -> dict:
     """The scenario, its reference final velocities, and the engine's at each dt in :data:`DTS`."""
     scenario = SCENARIOS[request.param]()
-    engine = {dt: tmem.simulate(with_changes(scenario, dt=dt)).state[-1, :, 0, 1] for dt in DTS}
+    engine = {dt: tmem.simulate(with_changes(scenario, {"simulation.dt": dt})).state[-1, :, 0, 1] for dt in DTS}
     return {"scenario": scenario, "reference": final_state(scenario)[:, 0, 1], "engine": engine}
 
 

@@ -16,18 +16,12 @@ from __future__ import annotations
 import numpy as np
 
 import tmem
-from tmem.engine import initial_state
 from tmem.metrics import rms_velocity
 from tmem.reference import final_state
-from tmem.scenario import Scenario, from_dict
+from tmem.scenario import Scenario, with_changes
+from tmem.setup import build
 
 DTS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
-
-
-def with_dt(scenario: Scenario, dt: float) -> Scenario:
-    data = scenario.model_dump()
-    data["simulation"]["dt"] = dt
-    return from_dict(data)
 
 
 def rms_change_percent(initial: np.ndarray, final: np.ndarray) -> float:
@@ -37,7 +31,7 @@ def rms_change_percent(initial: np.ndarray, final: np.ndarray) -> float:
 
 def engine_final(scenario: Scenario, dt: float) -> tuple[np.ndarray, float]:
     """Final velocities (agents,) and RMS change (%) of the engine at ``dt``."""
-    velocity = tmem.simulate(with_dt(scenario, dt)).state[..., 1]
+    velocity = tmem.simulate(with_changes(scenario, {"simulation.dt": dt})).state[..., 1]
     return velocity[-1, :, 0], rms_change_percent(velocity[0], velocity[-1])
 
 
@@ -52,7 +46,7 @@ def reference_table() -> list[str]:
         function = scenario.interaction.function
         reference = final_state(scenario)[..., 1]
         v_ref = reference[:, 0]
-        rms_ref = rms_change_percent(initial_state(scenario)[..., 1], reference)
+        rms_ref = rms_change_percent(build(scenario).state[..., 1], reference)
         for dt in DTS:
             v, rms = engine_final(scenario, dt)
             error = np.max(np.abs(v - v_ref))

@@ -18,7 +18,7 @@ import sys
 import time
 
 import tmem
-from tmem.metrics import interaction_distance, summarize
+from tmem.metrics import summarize
 from tmem.scenario import with_changes
 
 #: The values swept, one parameter at a time; the others keep the preset's value.
@@ -58,7 +58,7 @@ def run(name: str, field: str | None = None, value: float | None = None) -> dict
         "separated_t": pair["separated_at"],
         "amplitude": pair["oscillation_amplitude"],
         "min_distance": pair["min_distance"],
-        "closest_d": float(interaction_distance(trajectory).min()),
+        "closest_d": float(trajectory.interaction_distance.min()),
     }
 
 
