@@ -191,3 +191,42 @@ def test_recording_a_subset_of_agents():
     full = tmem.simulate(random_swarm(100, 2, True, "auto"))
     assert tr.state.shape[1] == 3 and tr.agents.tolist() == [3, 50, 7]
     np.testing.assert_array_equal(tr.state, full.state[:, [3, 50, 7]])
+
+
+def test_sparse_periodic_swarm_lists_every_neighbour_once():
+    """Few agents in a big periodic box: the cell grid is capped, and must never leave 2 cells round an axis."""
+    s = from_dict(
+        {
+            "interaction": {"function": "repulsion"},
+            "space": {"axes": 3, "periodic": True, "box": [500.0, 500.0, 500.0]},
+            "swarm": {"n": 40, "seed": 1, "speed_rms": 3.0, "region": [60.0, 60.0, 60.0]},
+            "simulation": {"dt": 0.01, "duration": 20.0, "record_every": 100},
+        }
+    )
+    a = tmem.simulate(with_changes(s, {"neighbors.method": "all"}))
+    b = tmem.simulate(with_changes(s, {"neighbors.method": "verlet"}))
+    assert a.final_state.tobytes() == b.final_state.tobytes()
+
+
+def test_recording_no_agents_keeps_the_pairs():
+    tr = tmem.simulate(formation("triangle", None, simulation={"duration": 2.0, "record_agents": []}))
+    assert tr.state.shape[1] == 0 and tr.flag.shape == (len(tr.time), 3)
+
+
+def test_direction_error_across_a_periodic_edge():
+    """A chain flying across the box edge keeps its bearing; the error must use the nearest image."""
+    s = from_dict(
+        {
+            "space": {"axes": 2, "periodic": True, "box": [200.0, 200.0]},
+            "interaction": {"function": "improved"},
+            "formation": {"kind": "chain", "n": 3, "bearing": True, "center": [150.0, 100.0], "velocity": [3.0, 0.0]},
+            "simulation": {"duration": 30.0},
+        }
+    )
+    assert summarize(tmem.simulate(s))["formation"]["direction_error_deg"] < 1.0
+
+
+def test_losing_an_agent_uncouples_its_pairs_as_events():
+    tr = tmem.simulate(formation("ring", 6, commands=[{"time": 5.0, "action": "remove", "agent": 2}]))
+    lost = sorted(e.agents for e in tr.events if e.kind == "uncouple")
+    assert lost == [(1, 2), (2, 3)] and all(e.time == pytest.approx(5.0) for e in tr.events)

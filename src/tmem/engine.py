@@ -255,7 +255,15 @@ def _advance_source(
             i = edge_i[e]
             j = edge_j[e]
             if not (active[i] and active[j]):
-                flag[e] = 0
+                if flag[e] == 1:  # the pair is lost with its agent
+                    flag[e] = 0
+                    event_step[n_events] = k
+                    event_kind[n_events] = coupling.EVENT_UNCOUPLE
+                    event_i[n_events] = i
+                    event_j[n_events] = j
+                    event_action[n_events] = -1
+                    n_events += 1
+                r_before[e] = np.nan
                 continue
             r2 = 0.0
             dist2 = 0.0
@@ -429,7 +437,7 @@ def simulate(
     cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt)
     n_steps = sim.n_steps
     steps = record_steps(n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
-    rec_agents = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents)
+    rec_agents = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
     if not record:
         rec_agents = rec_agents[:0]
     rec_state = np.empty((len(steps), len(rec_agents), n_axes, 4))

@@ -131,6 +131,8 @@ def direction_error_deg(trajectory: Trajectory) -> float | None:
         if np.isnan(direction[p, 0]) or i not in position or j not in position:
             continue
         delta = trajectory.state[:, position[j], :, 0] - trajectory.state[:, position[i], :, 0]
+        box = trajectory.setup.box
+        delta = np.where(box > 0, delta - box * np.round(delta / np.where(box > 0, box, 1.0)), delta)
         cosine = (delta @ direction[p]) / np.linalg.norm(delta, axis=1)
         angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))[trajectory.flag[:, p] == 1]
         if angle.size:

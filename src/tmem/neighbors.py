@@ -69,8 +69,13 @@ def _cells(points, active, cutoff, box):
     # Never more cells than about 2 per agent along all axes together.
     while np.prod(shape) > 2 * n + 8:
         a = np.argmax(shape)
-        shape[a] = max(1, shape[a] // 2)
-        size[a] = (box[a] if box[a] > 0.0 else size[a] * 2 * shape[a]) / shape[a]
+        halved = max(1, shape[a] // 2)
+        if box[a] > 0.0:
+            shape[a] = halved if halved >= 3 else 1  # as above: never 2 cells round a periodic axis
+            size[a] = box[a] / shape[a]
+        else:
+            size[a] = size[a] * shape[a] / halved
+            shape[a] = halved
     n_cells = np.prod(shape)
     cell_of = np.full(n, -1, dtype=np.int64)
     count = np.zeros(n_cells + 1, dtype=np.int64)

@@ -110,14 +110,16 @@ def formation_figure(trajectory: Trajectory):
 
 
 def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
-    """Write ``velocity.png``, ``distance.png`` (if pairs) and ``formation.png`` (if a formation)."""
-    makers = [("velocity.png", velocity_figure)]
+    """Write ``velocity.png`` (if agents were recorded), ``distance.png`` (if pairs) and ``formation.png``."""
+    makers = []
+    if trajectory.state.shape[1]:  # some agents recorded
+        makers.append(("velocity.png", velocity_figure))
     if len(trajectory.pairs):
         makers.append(("distance.png", distance_figure))
-    if trajectory.scenario.formation is not None:
+    if trajectory.scenario.formation is not None and len(trajectory.pairs):
         makers.append(("formation.png", formation_figure))
     paths = []
-    if not len(trajectory.time) or not trajectory.state.shape[1]:
+    if not len(trajectory.time):
         return paths
     for name, make in makers:
         fig = make(trajectory)
