@@ -34,13 +34,24 @@ is forced) and in float64 unless ``--float32``. If the neighbour list
 overflows (``nbrs.did_buffer_overflow`` after the warm-up run) it is
 reallocated with more capacity, the loop recompiled and the warm-up rerun.
 
+Choices (``--format``, ``--skin``): jax-md's ``OrderedSparse`` neighbour
+list (a Sparse list that stores each pair once; jax-md's own default for this
+energy function) and a skin of 8 m, the fastest measured here at N = 1e4 on
+2 CPU cores: Sparse was about 1.6x and Dense about 2-4x slower, and skins of
+6 to 16 m about equal, 2 m about 2x and jax-md's default 0.2 m over 10x
+slower (the list is then rebuilt every few steps).
+
 Pins (checked on Python 3.11, CPU, Linux x86-64): jax-md 0.2.29 (the newest
-on PyPI) with jax 0.10.2 and jaxlib 0.10.2 (what pip resolves for it). Install,
-in a separate environment from tmem's own (the project's optional extra
-``bench`` declares the same pins)::
+on PyPI) with jax 0.10.2 and jaxlib 0.10.2 (what pip resolves for it; jax-md
+also pulls in flax, optax, e3nn-jax, jraph, pymatgen and more, about 70
+packages). Install them in an environment of their own, not tmem's::
 
     python3 -m venv /tmp/jaxvenv
     /tmp/jaxvenv/bin/pip install "jax-md==0.2.29" "jax==0.10.2" "jaxlib==0.10.2"
+
+or, with the project's optional extra ``bench`` (the same pins), from the
+repository root: ``/tmp/jaxvenv/bin/pip install ".[bench]"``. The script needs
+only jax and jax-md, not tmem.
 
 Usage::
 
@@ -73,9 +84,9 @@ RMS_SPEED = 3.0  # m/s
 DT = 0.01  # s
 DEFAULT_STEPS = 1000
 DEFAULT_SEED = 20240611
-DEFAULT_SKIN = 8.0  # m, jax-md's dr_threshold: fastest of 2, 4, 6, 8, 12, 16 m at N = 1e4 (6 to 16 m about equal)
+DEFAULT_SKIN = 8.0  # m, jax-md's dr_threshold; fastest here, see the docstring
 FORMATS = ("dense", "sparse", "ordered-sparse")
-DEFAULT_FORMAT = "ordered-sparse"  # fastest here: Dense about 3-4x and Sparse about 2x slower at N = 1e4
+DEFAULT_FORMAT = "ordered-sparse"  # fastest here, see the docstring
 
 
 def box_side(n: int) -> float:
@@ -255,10 +266,13 @@ def main(argv: list[str] | None = None) -> None:
     machine = {"cpus": os.cpu_count(), "platform": platform.platform(), "python": platform.python_version()}
     print(f"machine: {machine['cpus']} CPUs, {machine['platform']}, Python {machine['python']}")
     print(
-        f"jax-md gas-N: {args.steps} steps, dt={DT} s, r_c={R_CUT} m, format={args.format}, skin={args.skin} m, "
-        f"{'float32' if args.float32 else 'float64'}, median of {args.repeat}, seed {args.seed}"
+        f"jax-md gas-N: {args.steps} steps, dt={DT} s, r_c={R_CUT} m, format={args.format}, "
+        f"skin={args.skin} m, {'float32' if args.float32 else 'float64'}, median of {args.repeat}, seed {args.seed}"
     )
-    header = f"{'N':>9} {'agent-steps/s':>14} {'median s':>9} {'cpu s':>8} {'compile s':>9} {'peak MB':>8} {'B/agent':>8} {'nbr idx':>12} {'load':>5}"
+    header = (
+        f"{'N':>9} {'agent-steps/s':>14} {'median s':>9} {'cpu s':>8} {'compile s':>9} {'peak MB':>8} "
+        f"{'B/agent':>8} {'nbr idx':>12} {'load':>5}"
+    )
     print(header)
     cases = []
     for n in args.n:
@@ -267,9 +281,11 @@ def main(argv: list[str] | None = None) -> None:
         res["loadavg_1min_before"] = load_before  # other work on the machine skews the figures
         res["loadavg_1min_after"] = os.getloadavg()[0]
         cases.append(res)
+        shape = "x".join(map(str, res["neighbour_list_shape"]))
         print(
-            f"{n:>9} {res['agent_steps_per_s']:>14.4g} {res['median_s']:>9.3f} {res['median_cpu_s']:>8.2f} {res['compile_s']:>9.2f} "
-            f"{res['peak_mb']:>8.0f} {res['bytes_per_agent']:>8.0f} {'x'.join(map(str, res['neighbour_list_shape'])):>12} {load_before:>5.2f}",
+            f"{n:>9} {res['agent_steps_per_s']:>14.4g} {res['median_s']:>9.3f} {res['median_cpu_s']:>8.2f} "
+            f"{res['compile_s']:>9.2f} {res['peak_mb']:>8.0f} {res['bytes_per_agent']:>8.0f} {shape:>12} "
+            f"{load_before:>5.2f}",
             flush=True,
         )
     if args.json is not None:
