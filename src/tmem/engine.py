@@ -193,8 +193,9 @@ def _advance_source(
                 for m in range(4):
                     s += x[i, a, m] * gains[m]
                 p_star[i, a] = s / gains[0]
-                delta = nearest_image(p_star[i, a] - p_ref[i, a], box[a])
-                shift2 += delta * delta
+                if use_lists:
+                    delta = nearest_image(p_star[i, a] - p_ref[i, a], box[a])
+                    shift2 += delta * delta
             moved[i] = shift2 if active[i] else 0.0
         if use_lists and (rebuild or np.sqrt(moved.max()) > 0.5 * skin):
             # The caller builds the lists (with p_ref = P* now) and resumes at step k.

@@ -313,15 +313,15 @@ class Scenario(_Strict):
             for k, a in enumerate(self.simulation.record_agents):
                 if not 0 <= a < n:
                     raise _FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
-        self._check_commands(n)
-        self._check_record_size(n)
+        pairs = self.pairs()  # generating a large formation is not free: once per validation
+        self._check_commands(n, pairs)
+        self._check_record_size(n, len(pairs))
         return self
 
-    def _check_record_size(self, n: int) -> None:
+    def _check_record_size(self, n: int, pairs: int) -> None:
         sim = self.simulation
         records = sim.n_steps // sim.record_every + 2
         agents = n if sim.record_agents is None else len(sim.record_agents)
-        pairs = len(self.pairs())
         size = records * (agents * (5 * self.space.axes * 8 + 1) + pairs * 32)
         if size > MAX_RECORD_BYTES:
             raise _FieldError(
@@ -387,8 +387,8 @@ class Scenario(_Strict):
                     raise _FieldError(f"formation.edges[{k}]", f"repeats the pair {sorted((i, j))}")
                 seen.add((min(i, j), max(i, j)))
 
-    def _check_commands(self, n: int) -> None:
-        pairs = {tuple(e) for e in self.pairs().tolist()} if self.commands else set()
+    def _check_commands(self, n: int, formation_pairs: np.ndarray) -> None:
+        pairs = {tuple(e) for e in formation_pairs.tolist()} if self.commands else set()
         active = [a.active for a in self.agents] if self.agents else [True] * n
         for k, command in sorted(enumerate(self.commands), key=lambda kc: kc[1].time):
             where = f"commands[{k}]"
