@@ -115,6 +115,23 @@ def _run_batch(
         uncouple_step[c] = uncoupled_at
 
 
+def unsupported(scenario: Scenario) -> str | None:
+    """Why ``scenario``'s cases cannot run as a batch, or ``None`` if they can.
+
+    A batch needs the paper's case: one axis, two agents flying from the
+    start without a formation, at most one command (an uncouple).  Only the
+    agents' positions and velocities vary; their tilts and tilt rates start at
+    zero.
+    """
+    if scenario.space.axes != 1 or len(scenario.agents) != 2 or scenario.formation is not None:
+        return "needs a one-axis scenario with two agents listed in [[agents]], without a formation"
+    if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
+        return "at most one command, an uncouple"
+    if any(a.tilt != 0 or a.tilt_rate != 0 or not a.active for a in scenario.agents):
+        return "the agents must start level (tilt and tilt rate zero) and flying"
+    return None
+
+
 def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray) -> BatchResult:
     """Run ``scenario`` once per case, with the two agents' starts taken from the arrays.
 
@@ -126,10 +143,9 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     positions, velocities : ndarray, shape (cases, 2)
         Each case's start (tilts and tilt rates zero).
     """
-    if scenario.space.axes != 1 or scenario.n_agents != 2 or scenario.formation is not None:
-        raise ValueError("run_batch: needs a one-axis scenario of two agents without a formation")
-    if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
-        raise ValueError("run_batch: at most one command, an uncouple")
+    reason = unsupported(scenario)
+    if reason:
+        raise ValueError(f"run_batch: {reason}")
     m, c, ia, sim = scenario.model, scenario.controller, scenario.interaction, scenario.simulation
     a, b = state_matrices(m.kp, m.kd, m.g)
     ad, bd = zero_order_hold(a, b, sim.dt)

@@ -57,6 +57,9 @@ class SimulationError(ValueError):
     """A run that could not be completed; the message is one line."""
 
 
+DIVERGED = "the run diverged (non-finite agent states); check the model and controller values and dt"
+
+
 @dataclass(frozen=True)
 class Event:
     """A coupling transition, or an operator command (``agents`` empty for several or every pair)."""
@@ -502,9 +505,7 @@ def simulate(
         chunk = int(min(max(chunk * 4, 1000), max(1000, chunk * chunk_seconds / max(elapsed, 1e-9))))
 
     if not np.all(np.isfinite(x[active])):
-        raise SimulationError(
-            "the run diverged (non-finite agent states); check the model and controller values and dt"
-        )
+        raise SimulationError(DIVERGED)
     events = []
     for e in range(n_events):
         kind = coupling.EVENT_KINDS[event_kind[e]]

@@ -30,7 +30,7 @@ class ScenarioError(ValueError):
     """A scenario that cannot be run; the message is one line naming the field."""
 
 
-class _Strict(BaseModel):
+class StrictModel(BaseModel):
     # strict: no quiet coercion of true to 1 or "6.0" to 6.0.
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
@@ -45,7 +45,7 @@ Pair = Annotated[list[int], Field(min_length=2, max_length=2)]
 MAX_RECORD_BYTES = 8 * 2**30
 
 
-class ModelParams(_Strict):
+class ModelParams(StrictModel):
     """Quadrocopter model (1)-(2), Table 1."""
 
     kp: Positive = 6.0
@@ -53,7 +53,7 @@ class ModelParams(_Strict):
     g: Positive = 9.8
 
 
-class ControllerParams(_Strict):
+class ControllerParams(StrictModel):
     """Roots (5) of the modal controller, Table 1."""
 
     r_l: Number = 12.0
@@ -68,7 +68,7 @@ class ControllerParams(_Strict):
         return v
 
 
-class InteractionParams(_Strict):
+class InteractionParams(StrictModel):
     """Interaction function and its parameters, (7)-(11)."""
 
     function: Literal["repulsion", "attraction", "switching", "improved"] = "improved"
@@ -86,13 +86,13 @@ class InteractionParams(_Strict):
     @model_validator(mode="after")
     def _coupling_inside_reach(self) -> "InteractionParams":
         if self.d_t >= self.reach:
-            raise _FieldError("d_t", f"must be less than R + R_j = {self.reach:g} m (condition (9)), got {self.d_t:g}")
+            raise FieldError("d_t", f"must be less than R + R_j = {self.reach:g} m (condition (9)), got {self.d_t:g}")
         if self.eps >= self.d_t:
-            raise _FieldError("eps", f"must be less than d_t = {self.d_t:g} m, got {self.eps:g}")
+            raise FieldError("eps", f"must be less than d_t = {self.d_t:g} m, got {self.eps:g}")
         return self
 
 
-class SimulationParams(_Strict):
+class SimulationParams(StrictModel):
     """Time stepping and recording (``record_agents``: the agents recorded; all by default)."""
 
     dt: Annotated[float, Field(ge=1e-9, le=LIMIT)] = 1e-4
@@ -107,14 +107,14 @@ class SimulationParams(_Strict):
     @model_validator(mode="after")
     def _whole_steps(self) -> "SimulationParams":
         if self.dt > self.duration:
-            raise _FieldError("dt", f"must not exceed duration = {self.duration:g} s, got {self.dt:g}")
+            raise FieldError("dt", f"must not exceed duration = {self.duration:g} s, got {self.dt:g}")
         steps = self.duration / self.dt
         if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
-            raise _FieldError("duration", f"must be a whole number of steps dt = {self.dt:g} s, got {self.duration:g}")
+            raise FieldError("duration", f"must be a whole number of steps dt = {self.dt:g} s, got {self.duration:g}")
         return self
 
 
-class SpaceParams(_Strict):
+class SpaceParams(StrictModel):
     """The space the agents fly in: 1 to 3 axes, optionally a periodic box."""
 
     axes: Literal[1, 2, 3] = 1
@@ -124,20 +124,20 @@ class SpaceParams(_Strict):
     @model_validator(mode="after")
     def _box_fits(self) -> "SpaceParams":
         if self.box is not None and len(self.box) != self.axes:
-            raise _FieldError("box", f"needs {self.axes} values (one per axis), got {len(self.box)}")
+            raise FieldError("box", f"needs {self.axes} values (one per axis), got {len(self.box)}")
         if self.periodic and self.box is None:
-            raise _FieldError("box", "is required when periodic = true")
+            raise FieldError("box", "is required when periodic = true")
         return self
 
 
-class NeighborParams(_Strict):
+class NeighborParams(StrictModel):
     """Neighbour search: every pair, or Verlet lists built from cells with a skin."""
 
     method: Literal["auto", "all", "verlet"] = "auto"
     skin: Positive = 4.0
 
 
-class FormationParams(_Strict):
+class FormationParams(StrictModel):
     """A formation: a generated shape, or edges among the ``[[agents]]``."""
 
     kind: Literal["chain", "ring", "triangle", "hex", "edges"]
@@ -155,23 +155,23 @@ class FormationParams(_Strict):
     def _kind_needs(self) -> "FormationParams":
         if self.kind == "edges":
             if not self.edges:
-                raise _FieldError("edges", 'is required (and not empty) for kind = "edges"')
+                raise FieldError("edges", 'is required (and not empty) for kind = "edges"')
             for name in ("n", "center", "velocity"):
                 if getattr(self, name) is not None:
-                    raise _FieldError(name, 'is not used with kind = "edges": give the [[agents]]')
+                    raise FieldError(name, 'is not used with kind = "edges": give the [[agents]]')
         else:
             if self.edges is not None:
-                raise _FieldError("edges", f'is only for kind = "edges", not {self.kind!r}')
+                raise FieldError("edges", f'is only for kind = "edges", not {self.kind!r}')
             if self.kind == "triangle" and self.n not in (None, 3):
-                raise _FieldError("n", f"a triangle has 3 agents, got {self.n}")
+                raise FieldError("n", f"a triangle has 3 agents, got {self.n}")
             if self.kind in ("chain", "ring", "hex") and self.n is None:
-                raise _FieldError("n", f"is required for kind = {self.kind!r}")
+                raise FieldError("n", f"is required for kind = {self.kind!r}")
             if self.kind == "ring" and self.n is not None and self.n < 3:
-                raise _FieldError("n", f"a ring needs at least 3 agents, got {self.n}")
+                raise FieldError("n", f"a ring needs at least 3 agents, got {self.n}")
         return self
 
 
-class SwarmParams(_Strict):
+class SwarmParams(StrictModel):
     """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``."""
 
     n: Annotated[int, Field(ge=2)]
@@ -183,7 +183,7 @@ class SwarmParams(_Strict):
 Vector = Number | list[Number]
 
 
-class Agent(_Strict):
+class Agent(StrictModel):
     """Initial state of one agent (Table 2): a number per axis, or one number on one axis."""
 
     position: Vector
@@ -193,7 +193,7 @@ class Agent(_Strict):
     active: bool = True
 
 
-class Command(_Strict):
+class Command(StrictModel):
     """An operator's command at ``time``.
 
     ``couple`` / ``uncouple`` act on ``pair``, on the listed ``pairs``, or on
@@ -211,14 +211,14 @@ class Command(_Strict):
     def _targets(self) -> "Command":
         if self.action in ("couple", "uncouple"):
             if self.agent is not None:
-                raise _FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
+                raise FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
             if self.pair is not None and self.pairs is not None:
-                raise _FieldError("pairs", "give pair or pairs, not both")
+                raise FieldError("pairs", "give pair or pairs, not both")
         else:
             if self.agent is None:
-                raise _FieldError("agent", f"is required for {self.action}")
+                raise FieldError("agent", f"is required for {self.action}")
             if self.pair is not None or self.pairs is not None:
-                raise _FieldError("pair", f"is for couple / uncouple, not {self.action}")
+                raise FieldError("pair", f"is for couple / uncouple, not {self.action}")
         return self
 
     @property
@@ -237,7 +237,7 @@ MAX_AGENTS_ALL_PAIRS = 2000
 TRACK_ALL_PAIRS = 32
 
 
-class Scenario(_Strict):
+class Scenario(StrictModel):
     """A whole scenario; see the module docstring.
 
     The agents come from exactly one of ``[[agents]]`` (Table 2),
@@ -294,11 +294,11 @@ class Scenario(_Strict):
         self._check_agents(axes)
         n = self.n_agents
         if n < 2:
-            raise _FieldError("agents", f"needs at least 2 agents, got {n}")
+            raise FieldError("agents", f"needs at least 2 agents, got {n}")
         if self.formation is not None:
             self._check_formation(axes, n)
         elif uses_coupling(self.interaction.function) and n > MAX_AGENTS_ALL_PAIRS:
-            raise _FieldError(
+            raise FieldError(
                 "interaction.function",
                 f"{self.interaction.function!r} without a [formation] makes all {n * (n - 1) // 2} pairs "
                 f"formation pairs; give a [formation] or use 'repulsion' beyond {MAX_AGENTS_ALL_PAIRS} agents",
@@ -306,13 +306,13 @@ class Scenario(_Strict):
         if self.swarm is not None:
             region = self.swarm.region or self.space.box
             if region is None:
-                raise _FieldError("swarm.region", "is required unless space.box is given")
+                raise FieldError("swarm.region", "is required unless space.box is given")
             if len(region) != axes:
-                raise _FieldError("swarm.region", f"needs {axes} values (one per axis), got {len(region)}")
+                raise FieldError("swarm.region", f"needs {axes} values (one per axis), got {len(region)}")
         if self.simulation.record_agents is not None:
             for k, a in enumerate(self.simulation.record_agents):
                 if not 0 <= a < n:
-                    raise _FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
+                    raise FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
         pairs = self.pairs()  # generating a large formation is not free: once per validation
         self._check_commands(n, pairs)
         self._check_record_size(n, len(pairs))
@@ -324,7 +324,7 @@ class Scenario(_Strict):
         agents = n if sim.record_agents is None else len(sim.record_agents)
         size = records * (agents * (5 * self.space.axes * 8 + 1) + pairs * 32)
         if size > MAX_RECORD_BYTES:
-            raise _FieldError(
+            raise FieldError(
                 "simulation.record_every",
                 f"the records would take {size / 2**30:.1f} GiB (at most {MAX_RECORD_BYTES / 2**30:g}); "
                 "record less often or fewer agents (record_agents)",
@@ -335,16 +335,16 @@ class Scenario(_Strict):
         sources = [name for name, given in (("agents", bool(self.agents)), ("formation", generated),
                                             ("swarm", self.swarm is not None)) if given]  # fmt: skip
         if len(sources) > 1:
-            raise _FieldError(sources[1], f"give the agents once: by {' or '.join(sources)}, not both")
+            raise FieldError(sources[1], f"give the agents once: by {' or '.join(sources)}, not both")
         if not sources:
-            raise _FieldError("agents", "no agents: give [[agents]], a [formation] or a [swarm]")
+            raise FieldError("agents", "no agents: give [[agents]], a [formation] or a [swarm]")
 
     def _check_agents(self, axes: int) -> None:
         seen: dict[tuple, int] = {}
         for k, agent in enumerate(self.agents):
             place = tuple(np.ravel(agent.position).tolist())
             if place in seen:
-                raise _FieldError(
+                raise FieldError(
                     f"agents[{k}].position",
                     f"is the place of agents[{seen[place]}]: two agents at one point have no direction to part in",
                 )
@@ -352,39 +352,39 @@ class Scenario(_Strict):
             for name in ("position", "velocity", "tilt", "tilt_rate"):
                 value = getattr(agent, name)
                 if isinstance(value, list) and len(value) != axes:
-                    raise _FieldError(f"agents[{k}].{name}", f"needs {axes} values (one per axis), got {len(value)}")
+                    raise FieldError(f"agents[{k}].{name}", f"needs {axes} values (one per axis), got {len(value)}")
                 if not isinstance(value, list) and axes > 1 and (name == "position" or value != 0.0):
-                    raise _FieldError(f"agents[{k}].{name}", f"needs a list of {axes} values for axes = {axes}")
+                    raise FieldError(f"agents[{k}].{name}", f"needs a list of {axes} values for axes = {axes}")
 
     def _check_formation(self, axes: int, n: int) -> None:
         f = self.formation
         if not uses_coupling(self.interaction.function):
-            raise _FieldError("formation", "needs interaction.function 'switching' (10) or 'improved' (11)")
+            raise FieldError("formation", "needs interaction.function 'switching' (10) or 'improved' (11)")
         if f.bearing and axes == 1:
-            raise _FieldError("formation.bearing", "a direction to hold needs 2 or 3 axes, got axes = 1")
+            raise FieldError("formation.bearing", "a direction to hold needs 2 or 3 axes, got axes = 1")
         if f.kind in ("ring", "triangle", "hex") and axes == 1:
-            raise _FieldError("formation.kind", f"{f.kind!r} is planar and needs 2 or 3 axes, got axes = 1")
+            raise FieldError("formation.kind", f"{f.kind!r} is planar and needs 2 or 3 axes, got axes = 1")
         d_t = f.d_t or self.interaction.d_t
         if d_t >= self.interaction.reach:
-            raise _FieldError("formation.d_t", f"must be less than R + R_j = {self.interaction.reach:g} m, got {d_t:g}")
+            raise FieldError("formation.d_t", f"must be less than R + R_j = {self.interaction.reach:g} m, got {d_t:g}")
         for name in ("center", "velocity"):
             value = getattr(f, name)
             if value is not None and len(value) != axes:
-                raise _FieldError(f"formation.{name}", f"needs {axes} values (one per axis), got {len(value)}")
+                raise FieldError(f"formation.{name}", f"needs {axes} values (one per axis), got {len(value)}")
         if f.kind == "edges":
             seen = set()
             for k, edge in enumerate(f.edges):
                 i, j = edge[:2]
                 if not (isinstance(i, int) and isinstance(j, int)):
-                    raise _FieldError(f"formation.edges[{k}]", f"needs two agent indices first, got {list(edge)}")
+                    raise FieldError(f"formation.edges[{k}]", f"needs two agent indices first, got {list(edge)}")
                 if len(edge) == 3 and not 0 < edge[2]:
-                    raise _FieldError(f"formation.edges[{k}]", f"d_t must be > 0, got {edge[2]}")
+                    raise FieldError(f"formation.edges[{k}]", f"d_t must be > 0, got {edge[2]}")
                 if not (0 <= i < n and 0 <= j < n) or i == j:
-                    raise _FieldError(f"formation.edges[{k}]", f"needs two different agents in 0..{n - 1}, got {list(edge)}")
+                    raise FieldError(f"formation.edges[{k}]", f"needs two different agents in 0..{n - 1}, got {list(edge)}")
                 if len(edge) == 3 and edge[2] >= self.interaction.reach:
-                    raise _FieldError(f"formation.edges[{k}]", f"d_t must be less than R + R_j = {self.interaction.reach:g} m")
+                    raise FieldError(f"formation.edges[{k}]", f"d_t must be less than R + R_j = {self.interaction.reach:g} m")
                 if (min(i, j), max(i, j)) in seen:
-                    raise _FieldError(f"formation.edges[{k}]", f"repeats the pair {sorted((i, j))}")
+                    raise FieldError(f"formation.edges[{k}]", f"repeats the pair {sorted((i, j))}")
                 seen.add((min(i, j), max(i, j)))
 
     def _check_commands(self, n: int, formation_pairs: np.ndarray) -> None:
@@ -393,32 +393,32 @@ class Scenario(_Strict):
         for k, command in sorted(enumerate(self.commands), key=lambda kc: kc[1].time):
             where = f"commands[{k}]"
             if command.time > self.simulation.duration:
-                raise _FieldError(
+                raise FieldError(
                     f"{where}.time", f"must not be later than duration = {self.simulation.duration:g} s, got {command.time:g}"
                 )
             if command.agent is not None:
                 if not 0 <= command.agent < n:
-                    raise _FieldError(f"{where}.agent", f"names agent {command.agent}, outside 0..{n - 1}")
+                    raise FieldError(f"{where}.agent", f"names agent {command.agent}, outside 0..{n - 1}")
                 wanted = command.action == "remove"
                 if active[command.agent] != wanted:
                     state = "not flying" if wanted else "already flying"
-                    raise _FieldError(f"{where}.agent", f"cannot {command.action} agent {command.agent}: it is {state} then")
+                    raise FieldError(f"{where}.agent", f"cannot {command.action} agent {command.agent}: it is {state} then")
                 active[command.agent] = not wanted
             field = f"{where}.pair" if command.pair is not None else f"{where}.pairs"
             for i, j in command.targets or []:
                 if not (0 <= i < n and 0 <= j < n):
-                    raise _FieldError(field, f"names agent outside 0..{n - 1}: {[i, j]}")
+                    raise FieldError(field, f"names agent outside 0..{n - 1}: {[i, j]}")
                 if i == j:
-                    raise _FieldError(field, f"needs two different agents, got {[i, j]}")
+                    raise FieldError(field, f"needs two different agents, got {[i, j]}")
                 if (min(i, j), max(i, j)) not in pairs:
-                    raise _FieldError(field, f"{[i, j]} is not a formation pair")
+                    raise FieldError(field, f"{[i, j]} is not a formation pair")
 
     def to_toml(self) -> str:
         """The scenario as TOML text, every default written out."""
         return _to_toml(self.model_dump(mode="json", exclude_none=True))
 
 
-class _FieldError(ValueError):
+class FieldError(ValueError):
     """Raised by a cross-field check to name the field at fault, relative to its table."""
 
     def __init__(self, field: str, reason: str):
@@ -453,8 +453,8 @@ def _explain(error: dict) -> str:
         reason = f"must be a finite number, got {error['input']}"
     else:
         ctx_error = error.get("ctx", {}).get("error")
-        if isinstance(ctx_error, _FieldError):
-            where = f"{where}.{ctx_error.field}" if where else ctx_error.field
+        if isinstance(ctx_error, FieldError):
+            where = f"{where}.{ctx_error.field}" if where and ctx_error.field else (where or ctx_error.field)
             reason = ctx_error.reason
         else:
             reason = error["msg"].removeprefix("Value error, ")
@@ -465,12 +465,17 @@ def _explain(error: dict) -> str:
     return f"{where}: {reason}" if where else reason
 
 
+def describe(exc: ValidationError) -> str:
+    """A validation failure as one line: each error's field and reason, in the file's words."""
+    return "; ".join(_explain(e) for e in exc.errors())
+
+
 def from_dict(data: dict) -> Scenario:
     """Validate a scenario given as nested dicts; raise :class:`ScenarioError`."""
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        raise ScenarioError("; ".join(_explain(e) for e in exc.errors())) from None
+        raise ScenarioError(describe(exc)) from None
 
 
 def load(path: str | Path) -> Scenario:
