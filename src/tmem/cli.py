@@ -1,4 +1,4 @@
-"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` a run.
+"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` a run, ``sweep`` many.
 
 User mistakes (a bad scenario, an unusable output directory) end with one
 line on standard error naming the field and the reason, exit status 2 and no
@@ -127,6 +127,43 @@ def animate_command(
     except (ValueError, OSError) as exc:
         _fail(str(exc))
     Console().print(f"written {path}")
+
+
+@app.command("sweep")
+def sweep_command(
+    sweep_file: Path = typer.Argument(..., help="Sweep TOML file (see examples/sweeps/ and docs/sweeps.md)."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output directory; run again to resume an interrupted sweep."),
+    scheduler: str = typer.Option(None, help="Address of an existing Dask scheduler; default: a local cluster."),
+    workers: int = typer.Option(None, min=1, help="Worker processes of the local cluster; default: one per core."),
+) -> None:
+    """Run every case of SWEEP_FILE on Dask; write results.parquet, summary.md and figures to OUT."""
+    from .sweep import SweepError, SweepInterrupted, load_sweep, run_sweep
+
+    try:
+        sweep = load_sweep(sweep_file)
+        text = sweep_file.read_text(encoding="utf-8")
+    except SweepError as exc:
+        _fail(str(exc))
+    bar = Progress(
+        TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} cases"),
+        TimeRemainingColumn(), console=console, transient=True, disable=not console.is_terminal,
+    )  # fmt: skip
+    task = bar.add_task(sweep.name, total=sweep.n_cases)
+    try:
+        with bar:
+            outcome = run_sweep(
+                sweep, text, out, scheduler=scheduler, workers=workers,
+                progress=lambda done, total: bar.update(task, completed=done),
+            )  # fmt: skip
+    except (SweepError, OutputError) as exc:
+        _fail(str(exc))
+    except SweepInterrupted as exc:
+        console.print(escape(str(exc)), highlight=False)
+        raise typer.Exit(130) from None
+    Console().print(
+        f"{len(outcome.table)} cases ({outcome.ran} run now, {outcome.failed} failed) in {outcome.seconds:.1f} s; "
+        f"written to {out}/results.parquet and {out}/summary.md"
+    )
 
 
 def main() -> None:

@@ -1,0 +1,160 @@
+"""Running a sweep on Dask: local by default, or an existing cluster by its scheduler's address.
+
+:func:`run_sweep` opens the output directory (:mod:`tmem.sweep.store`),
+leaves out the cases already done, groups the others into chunks
+(:func:`tmem.sweep.tasks.plan_chunks`), submits one task per chunk and
+writes rows as tasks finish.  The local cluster and a remote one take the
+same path: a :class:`dask.distributed.Client` and its futures.  A remote
+cluster's workers need tmem installed, in the same version.
+
+Nothing is lost when a sweep stops early: on Ctrl-C the rows received are
+written before :class:`SweepInterrupted` is raised; a killed worker's tasks
+are run again by Dask on the others; after a killed client, the parts on
+disk are whole.  The same command then runs only what is missing.  A task
+that fails as a whole (its worker killed again and again) gives its cases
+rows with the error, like a case that raises.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from .report import write_report
+from .spec import Case, Sweep, SweepError
+from .store import ResultStore
+from .tasks import plan_chunks, run_chunk
+
+#: Rows are written to disk at least this often (s) while tasks finish, and whenever this many wait.
+FLUSH_SECONDS = 2.0
+FLUSH_ROWS = 2000
+
+
+class SweepInterrupted(Exception):
+    """The sweep was stopped (Ctrl-C) after writing the rows it had; ``done`` of ``total`` cases are saved."""
+
+    def __init__(self, done: int, total: int):
+        super().__init__(f"interrupted: {done} of {total} cases saved; run the same command again to go on")
+        self.done = done
+        self.total = total
+
+
+@dataclass(frozen=True)
+class SweepOutcome:
+    """What :func:`run_sweep` did: every case's row, how many ran now, how many failed."""
+
+    table: pd.DataFrame
+    ran: int
+    failed: int
+    seconds: float
+
+
+@contextmanager
+def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
+    """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout="20s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise SweepError(f"--scheduler {scheduler}: cannot connect ({' '.join(str(exc).split())})") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    cluster = LocalCluster(
+        n_workers=workers or os.cpu_count() or 1,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        silence_logs=logging.ERROR,
+        env={"NUMBA_NUM_THREADS": "1"},  # one process per core; no threads within
+    )  # fmt: skip
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+def _failed_rows(chunk: list[Case], metrics: tuple[str, ...], exc: BaseException) -> list[dict]:
+    message = f"{exc.__class__.__name__}: {' '.join(str(exc).split())}"
+    rows = []
+    for case in chunk:
+        rows.append({"case": case.index, **case.changes, **dict.fromkeys(metrics), "error": message, "seconds": None})
+    return rows
+
+
+def run_sweep(
+    sweep: Sweep,
+    text: str,
+    out: str | Path,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> SweepOutcome:
+    """Run every case of ``sweep`` not yet done in ``out``; write the table, ``summary.md`` and figures.
+
+    Parameters
+    ----------
+    sweep, text
+        The checked sweep and its file's text (kept in ``out/sweep.toml``).
+    out
+        The output directory: new, or holding this sweep's results so far.
+    scheduler
+        Address of an existing Dask scheduler (``tcp://host:8786``); by
+        default a local cluster of ``workers`` processes (all cores).
+    progress
+        Called as ``progress(cases_done, cases_total)`` as tasks finish.
+
+    Raises :class:`SweepInterrupted` on Ctrl-C, after saving what finished.
+    """
+    started = time.perf_counter()
+    out = Path(out)
+    store = ResultStore.open(out, sweep, text)
+    metrics = store.metrics
+    done_before = store.done_cases()
+    todo = [c for c in sweep.cases() if c.index not in done_before]
+    done = sweep.n_cases - len(todo)
+    ran = 0
+    if progress:
+        progress(done, sweep.n_cases)
+    if todo:
+        waiting: list[dict] = []
+        last_flush = time.perf_counter()
+        with dask_client(scheduler, workers) as client:
+            from dask.distributed import as_completed
+
+            base = client.scatter(sweep.base, broadcast=True)
+            chunks = plan_chunks(sweep.base, todo, metrics, sweep.spec.batch)
+            futures = {client.submit(run_chunk, base, chunk, metrics, pure=False): chunk for chunk in chunks}
+            try:
+                for future in as_completed(futures):
+                    chunk = futures.pop(future)
+                    try:
+                        waiting += future.result()
+                    except Exception as exc:  # the task as a whole failed: its cases get the error
+                        waiting += _failed_rows(chunk, metrics, exc)
+                    ran += len(chunk)
+                    if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS or not futures:
+                        store.add(waiting)
+                        waiting, last_flush = [], time.perf_counter()
+                    if progress:
+                        progress(done + ran, sweep.n_cases)
+            except KeyboardInterrupt:
+                store.add(waiting)
+                client.cancel(list(futures))
+                raise SweepInterrupted(done + ran, sweep.n_cases) from None
+    table = store.finish()
+    write_report(table, sweep, out)
+    return SweepOutcome(table=table, ran=ran, failed=int(table["error"].notna().sum()), seconds=time.perf_counter() - started)

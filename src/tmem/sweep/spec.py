@@ -1,0 +1,313 @@
+"""Sweep files: a base scenario and what varies, checked and expanded into numbered cases.
+
+A sweep file is TOML::
+
+    name = "encounters"
+    base = "fig7"            # a preset, or a scenario file (relative to this file)
+    cases = 10000            # random draws; the same draws at every grid point
+    seed = 1                 # of the random draws
+    metrics = ["rms_change_percent", "coupled", "couple_time", "uncouple_time"]
+    batch = 500              # cases per Dask task (optional)
+
+    [set]                    # fixed changes to the base (optional)
+    "agents.0.position" = 0.0
+
+    [grid]                   # every combination of these lists
+    "interaction.function" = ["switching", "improved"]
+
+    [random]                 # drawn per case: uniform, loguniform, normal or choice
+    "agents.1.position" = { uniform = [45, 80] }
+
+    [[case]]                 # explicit cases, each a table of changes (optional)
+    "interaction.c_max" = 0.05
+
+Keys are dotted parameter paths of the scenario (``interaction.c_max``,
+``agents.1.velocity``), as in :func:`tmem.scenario.with_changes`.  The cases
+are every explicit case (or one empty case) times every grid point times
+every random draw, numbered in that order; a case's number and its values
+depend only on the file, so a sweep run again, or resumed, has the same
+cases.  Drawing the same random starts at every grid point makes the grid's
+settings compare on equal terms (a paired comparison).
+
+Every mistake is a :class:`SweepError` with a one-line message naming the
+key and the reason, found before anything runs: an empty grid, a range with
+low > high, an unknown parameter path, a value the scenario refuses at some
+grid point, an unknown metric.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import re
+import tomllib
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import Field, ValidationError, model_validator
+
+from ..scenario import (
+    PRESETS,
+    FieldError,
+    Number,
+    Scenario,
+    ScenarioError,
+    StrictModel,
+    describe,
+    load,
+    preset,
+    with_changes,
+)
+
+#: Metrics of ``summary.json`` (:func:`tmem.metrics.summarize`) a sweep can keep, with the batch's too.
+SCALAR_METRICS = (
+    "rms_velocity_initial",
+    "rms_velocity_final",
+    "rms_change_percent",
+    "min_distance",
+    "final_distance",
+    "coupled",
+    "couple_time",
+    "uncouple_time",
+)
+_PAIR_KEYS = (
+    "coupled_at|uncoupled_at|separated_at|min_distance|final_distance|mean_distance_coupled"
+    "|oscillation_amplitude|distance_error\\.(mean|rms|max)"
+)
+_FORMATION_KEYS = "formed_at|coupled_at_end|amplitude_max|direction_error_deg|distance_error\\.(mean|rms|max)"
+#: Nested figures of ``summary.json`` by dotted path: per formation, and per pair (by its index).
+NESTED_METRIC = re.compile(rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})")
+#: Most cases one sweep may have.
+MAX_CASES = 10_000_000
+
+
+class SweepError(ValueError):
+    """A sweep that cannot be run; the message is one line naming the key."""
+
+
+class Distribution(StrictModel):
+    """How one parameter is drawn: exactly one of the four kinds."""
+
+    uniform: list[Number] | None = Field(None, min_length=2, max_length=2)
+    loguniform: list[Number] | None = Field(None, min_length=2, max_length=2)
+    normal: list[Number] | None = Field(None, min_length=2, max_length=2)
+    choice: list[Any] | None = Field(None, min_length=1)
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> "Distribution":
+        given = [k for k in ("uniform", "loguniform", "normal", "choice") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise FieldError("", "give exactly one of uniform, loguniform, normal, choice")
+        for kind in ("uniform", "loguniform"):
+            bounds = getattr(self, kind)
+            if bounds is not None and bounds[0] > bounds[1]:
+                raise FieldError(kind, f"low {bounds[0]} > high {bounds[1]}")
+        if self.loguniform is not None and self.loguniform[0] <= 0:
+            raise FieldError("loguniform", f"low must be > 0, got {self.loguniform[0]}")
+        if self.normal is not None and self.normal[1] < 0:
+            raise FieldError("normal", f"the standard deviation must be >= 0, got {self.normal[1]}")
+        return self
+
+    def draw(self, rng: np.random.Generator, n: int) -> list:
+        """``n`` values (Python numbers or the listed choices)."""
+        if self.uniform is not None:
+            return rng.uniform(*self.uniform, size=n).tolist()
+        if self.loguniform is not None:
+            low, high = np.log(self.loguniform)
+            return np.exp(rng.uniform(low, high, size=n)).tolist()
+        if self.normal is not None:
+            return rng.normal(*self.normal, size=n).tolist()
+        return [self.choice[i] for i in rng.integers(len(self.choice), size=n)]
+
+
+class SweepFile(StrictModel):
+    """The sweep file's schema; see the module docstring."""
+
+    name: str = ""
+    base: str
+    cases: int | None = Field(None, ge=1, le=MAX_CASES)
+    seed: int = Field(0, ge=0)
+    batch: int | None = Field(None, ge=1, le=1_000_000)
+    metrics: list[str] = Field(list(SCALAR_METRICS), min_length=1)
+    set: dict[str, Any] = {}
+    grid: dict[str, list[Any]] = {}
+    random: dict[str, Distribution] = {}
+    case: list[dict[str, Any]] = []
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "SweepFile":
+        for path, values in self.grid.items():
+            if not values:
+                raise FieldError(f"grid.{path}", "is empty; give at least one value")
+        if self.random and self.cases is None:
+            raise FieldError("cases", "is required with a [random] table: how many draws")
+        if self.cases is not None and not self.random:
+            raise FieldError("cases", "counts random draws, but there is no [random] table")
+        for m in self.metrics:
+            if m not in SCALAR_METRICS and not NESTED_METRIC.fullmatch(m):
+                raise FieldError("metrics", f"unknown metric {m!r}; choose from {', '.join(SCALAR_METRICS)}, formation.*, pairs.N.*")
+        if len(set(self.metrics)) != len(self.metrics):
+            raise FieldError("metrics", "lists a metric twice")
+        where: dict[str, str] = {}  # path -> the table that gives it; explicit cases may share paths
+        tables = [("set", self.set), ("grid", self.grid), ("random", self.random)]
+        tables += [(f"case[{i}]", c) for i, c in enumerate(self.case)]
+        for table_name, table in tables:
+            for path in table:
+                if path in ("case", "error", "seconds") or path in self.metrics:
+                    raise FieldError(f"{table_name}.{path}", "is a column of the results, not a parameter path")
+                kind = table_name.split("[")[0]
+                if path in where and where[path].split("[")[0] != kind:
+                    raise FieldError(f"{table_name}.{path}", f"is also given in {where[path]}")
+                where.setdefault(path, table_name)
+        total = max(len(self.case), 1) * _product([len(v) for v in self.grid.values()]) * (self.cases or 1)
+        if total > MAX_CASES:
+            raise FieldError("cases", f"the sweep has {total} cases; at most {MAX_CASES}")
+        return self
+
+
+def _product(sizes: list[int]) -> int:
+    return int(np.prod(sizes, dtype=np.int64)) if sizes else 1
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run of the sweep: its number and its changes to the base scenario (path to value)."""
+
+    index: int
+    changes: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A checked sweep: the base scenario (with the file's ``[set]`` changes), the file's content, its source."""
+
+    spec: SweepFile
+    base: Scenario
+    source: str
+
+    @property
+    def name(self) -> str:
+        return self.spec.name or Path(self.source).stem
+
+    @property
+    def parameters(self) -> list[str]:
+        """The parameter paths that vary from case to case, in file order."""
+        paths = list(self.spec.grid) + list(self.spec.random)
+        for case in self.spec.case:
+            paths += [p for p in case if p not in paths]
+        return paths
+
+    @property
+    def settings(self) -> list[str]:
+        """The varied paths that are not drawn at random: each of their combinations is a setting."""
+        return [p for p in self.parameters if p not in self.spec.random]
+
+    @property
+    def n_cases(self) -> int:
+        return max(len(self.spec.case), 1) * _product([len(v) for v in self.spec.grid.values()]) * (self.spec.cases or 1)
+
+    def _settings(self) -> list[dict[str, Any]]:
+        """Every explicit case times every grid point, in case order."""
+        explicit = self.spec.case or [{}]
+        grid = [dict(zip(self.spec.grid, values)) for values in itertools.product(*self.spec.grid.values())]
+        return [{**e, **g} for e in explicit for g in grid]
+
+    @cached_property
+    def _draws(self) -> list[dict[str, Any]]:
+        n = self.spec.cases or 1
+        rng = np.random.default_rng(self.spec.seed)
+        columns = {path: dist.draw(rng, n) for path, dist in sorted(self.spec.random.items())}
+        return [{path: values[r] for path, values in columns.items()} for r in range(n)]
+
+    def cases(self) -> list[Case]:
+        """Every case, numbered from 0: explicit case, then grid point, then random draw."""
+        draws = self._draws
+        return [
+            Case(s * len(draws) + r, {**setting, **draw})
+            for s, setting in enumerate(self._settings())
+            for r, draw in enumerate(draws)
+        ]
+
+    @property
+    def fingerprint(self) -> str:
+        """A digest of everything that decides the cases and their rows (not ``batch``)."""
+        content = self.spec.model_dump(mode="json", exclude={"batch"})
+        content["base"] = self.base.model_dump(mode="json")
+        return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
+
+    def check(self) -> None:
+        """Build the scenario of every setting with the first random draw; raise :class:`SweepError`."""
+        draw = self._draws[0]
+        for setting in self._settings():
+            try:
+                with_changes(self.base, {**setting, **draw})
+            except ScenarioError as exc:
+                values = ", ".join(f"{p} = {v!r}" for p, v in setting.items() if p in self.settings)
+                where = f" (at {values})" if values else ""
+                raise SweepError(f"{self.source}: {exc}{where}") from None
+
+
+def _dotted(table: dict, prefix: str = "") -> dict:
+    """``{"interaction": {"c_max": [..]}}`` as ``{"interaction.c_max": [..]}``: both spellings mean a path.
+
+    A table whose keys are a distribution's kinds is a value, not a level of the path.
+    """
+    flat = {}
+    for key, value in table.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict) and value and not value.keys() <= Distribution.model_fields.keys():
+            flat.update(_dotted(value, f"{path}."))
+        else:
+            flat[path] = value
+    return flat
+
+
+def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = None) -> Sweep:
+    """Parse and check a sweep given as TOML text; ``directory`` anchors a relative ``base`` path."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepError(f"{source}: TOML syntax error: {exc}") from None
+    for table in ("set", "grid", "random"):
+        if isinstance(data.get(table), dict):
+            data[table] = _dotted(data[table])
+    if isinstance(data.get("case"), list):
+        data["case"] = [_dotted(c) if isinstance(c, dict) else c for c in data["case"]]
+    try:
+        spec = SweepFile.model_validate(data)
+    except ValidationError as exc:
+        raise SweepError(f"{source}: {describe(exc)}") from None
+    try:
+        if spec.base.endswith(".toml"):
+            base = load((directory or Path.cwd()) / spec.base)
+        elif spec.base in PRESETS:
+            base = preset(spec.base)
+        else:
+            raise ScenarioError(f"base: {spec.base!r} is neither a preset ({', '.join(PRESETS)}) nor a .toml file")
+    except ScenarioError as exc:
+        raise SweepError(f"{source}: {exc}") from None
+    try:
+        base = with_changes(base, spec.set)
+    except ScenarioError as exc:
+        raise SweepError(f"{source}: set: {exc}") from None
+    sweep = Sweep(spec=spec, base=base, source=source)
+    sweep.check()
+    return sweep
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    """Read and check a sweep file; raise :class:`SweepError`."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SweepError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise SweepError(f"{path}: is a directory, not a sweep file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SweepError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
+    return loads_sweep(text, source=str(path), directory=path.parent)
