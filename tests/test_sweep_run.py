@@ -39,12 +39,11 @@ batch = {batch}
 
 
 def encounters(cases=6, batch=3):
-    text = ENCOUNTERS.format(cases=cases, batch=batch)
-    return loads_sweep(text, source="encounters.toml"), text
+    return loads_sweep(ENCOUNTERS.format(cases=cases, batch=batch), source="encounters.toml")
 
 
 def test_batched_rows_equal_single_runs_of_the_engine():
-    sweep, _ = encounters()
+    sweep = encounters()
     metrics = tuple(SCALAR_METRICS)
     cases = sweep.cases()
     chunks = plan_chunks(sweep.base, cases, metrics, None)
@@ -118,8 +117,8 @@ def cluster():
 
 
 def test_a_sweep_through_a_real_cluster_address_has_one_row_per_case(cluster, tmp_path):
-    sweep, text = encounters(cases=10, batch=4)
-    outcome = run_sweep(sweep, text, tmp_path / "out", scheduler=cluster.scheduler_address)
+    sweep = encounters(cases=10, batch=4)
+    outcome = run_sweep(sweep, tmp_path / "out", scheduler=cluster.scheduler_address)
     table = pd.read_parquet(tmp_path / "out" / "results.parquet")
     assert list(table["case"]) == list(range(20))
     assert outcome.ran == 20 and outcome.failed == 0
@@ -127,13 +126,13 @@ def test_a_sweep_through_a_real_cluster_address_has_one_row_per_case(cluster, tm
     assert (tmp_path / "out" / "summary.md").exists() and (tmp_path / "out" / "rms_change_histogram.png").exists()
     assert not (tmp_path / "out" / "parts").exists()
     # run again: nothing left to run, the same table
-    again = run_sweep(sweep, text, tmp_path / "out", scheduler=cluster.scheduler_address)
+    again = run_sweep(sweep, tmp_path / "out", scheduler=cluster.scheduler_address)
     assert again.ran == 0
     pd.testing.assert_frame_equal(again.table, table)
 
 
 def test_an_interrupted_sweep_resumes_with_only_the_missing_cases(cluster, tmp_path):
-    sweep, text = encounters(cases=12, batch=2)
+    sweep = encounters(cases=12, batch=2)
     out = tmp_path / "out"
     seen = []
 
@@ -143,24 +142,24 @@ def test_an_interrupted_sweep_resumes_with_only_the_missing_cases(cluster, tmp_p
             raise KeyboardInterrupt
 
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(sweep, text, out, scheduler=cluster.scheduler_address, progress=interrupt_after_some)
+        run_sweep(sweep, out, scheduler=cluster.scheduler_address, progress=interrupt_after_some)
     saved = info.value.done
     assert 6 <= saved < 24
     assert not (out / "results.parquet").exists()
     parts = pd.concat([pd.read_parquet(p) for p in (out / "parts").glob("part-*.parquet")])
     assert len(parts) == saved and parts["case"].is_unique
-    resumed = run_sweep(sweep, text, out, scheduler=cluster.scheduler_address)
+    resumed = run_sweep(sweep, out, scheduler=cluster.scheduler_address)
     assert resumed.ran == 24 - saved
     table = pd.read_parquet(out / "results.parquet")
     assert list(table["case"]) == list(range(24))
     # the rows saved before the interruption are those an uninterrupted sweep gives
-    whole = run_sweep(sweep, text, tmp_path / "whole", scheduler=cluster.scheduler_address).table
+    whole = run_sweep(sweep, tmp_path / "whole", scheduler=cluster.scheduler_address).table
     cols = ["case", *sweep.parameters, *sweep.spec.metrics]
     pd.testing.assert_frame_equal(table[cols], whole[cols])
 
 
 def test_a_killed_worker_loses_no_case(tmp_path):
-    sweep, text = encounters(cases=40, batch=2)
+    sweep = encounters(cases=40, batch=2)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         client = Client(cluster)
         killed = []
@@ -171,7 +170,7 @@ def test_a_killed_worker_loses_no_case(tmp_path):
                 os.kill(pid, signal.SIGKILL)
                 killed.append(pid)
 
-        outcome = run_sweep(sweep, text, tmp_path / "out", scheduler=cluster.scheduler_address, progress=kill_a_worker_once)
+        outcome = run_sweep(sweep, tmp_path / "out", scheduler=cluster.scheduler_address, progress=kill_a_worker_once)
         client.close()
     assert killed
     assert list(outcome.table["case"]) == list(range(80))

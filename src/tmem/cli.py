@@ -141,7 +141,6 @@ def sweep_command(
 
     try:
         sweep = load_sweep(sweep_file)
-        text = sweep_file.read_text(encoding="utf-8")
     except SweepError as exc:
         _fail(str(exc))
     bar = Progress(
@@ -152,7 +151,7 @@ def sweep_command(
     try:
         with bar:
             outcome = run_sweep(
-                sweep, text, out, scheduler=scheduler, workers=workers,
+                sweep, out, scheduler=scheduler, workers=workers,
                 progress=lambda done, total: bar.update(task, completed=done),
             )  # fmt: skip
     except (SweepError, OutputError) as exc:

@@ -478,18 +478,22 @@ def from_dict(data: dict) -> Scenario:
         raise ScenarioError(describe(exc)) from None
 
 
+def read_text(path: Path, what: str, error: type[ValueError]) -> str:
+    """The text of the ``what`` file at ``path``; a missing or unreadable file raises ``error`` in one line."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise error(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise error(f"{path}: is a directory, not a {what} file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise error(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
+
+
 def load(path: str | Path) -> Scenario:
     """Read and validate a scenario TOML file; raise :class:`ScenarioError`."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise ScenarioError(f"{path}: is a directory, not a scenario file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
-    return loads(text, source=str(path))
+    return loads(read_text(path, "scenario", ScenarioError), source=str(path))
 
 
 def loads(text: str, source: str = "<scenario>") -> Scenario:

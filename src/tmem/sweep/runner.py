@@ -97,7 +97,6 @@ def _failed_rows(chunk: list[Case], metrics: tuple[str, ...], exc: BaseException
 
 def run_sweep(
     sweep: Sweep,
-    text: str,
     out: str | Path,
     scheduler: str | None = None,
     workers: int | None = None,
@@ -107,8 +106,8 @@ def run_sweep(
 
     Parameters
     ----------
-    sweep, text
-        The checked sweep and its file's text (kept in ``out/sweep.toml``).
+    sweep
+        The checked sweep (its file is kept in ``out/sweep.toml``).
     out
         The output directory: new, or holding this sweep's results so far.
     scheduler
@@ -121,7 +120,7 @@ def run_sweep(
     """
     started = time.perf_counter()
     out = Path(out)
-    store = ResultStore.open(out, sweep, text)
+    store = ResultStore.open(out, sweep)
     metrics = store.metrics
     done_before = store.done_cases()
     todo = [c for c in sweep.cases() if c.index not in done_before]

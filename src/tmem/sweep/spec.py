@@ -60,6 +60,7 @@ from ..scenario import (
     describe,
     load,
     preset,
+    read_text,
     with_changes,
 )
 
@@ -82,7 +83,7 @@ _FORMATION_KEYS = "formed_at|coupled_at_end|amplitude_max|direction_error_deg|di
 #: Nested figures of ``summary.json`` by dotted path: per formation, and per pair (by its index).
 NESTED_METRIC = re.compile(rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})")
 #: Most cases one sweep may have.
-MAX_CASES = 10_000_000
+MAX_CASES = 1_000_000
 
 
 class SweepError(ValueError):
@@ -183,11 +184,12 @@ class Case:
 
 @dataclass(frozen=True)
 class Sweep:
-    """A checked sweep: the base scenario (with the file's ``[set]`` changes), the file's content, its source."""
+    """A checked sweep: the file's content, the base scenario (with its ``[set]`` changes), where it came from."""
 
     spec: SweepFile
     base: Scenario
     source: str
+    text: str
 
     @property
     def name(self) -> str:
@@ -294,7 +296,7 @@ def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = Non
         base = with_changes(base, spec.set)
     except ScenarioError as exc:
         raise SweepError(f"{source}: set: {exc}") from None
-    sweep = Sweep(spec=spec, base=base, source=source)
+    sweep = Sweep(spec=spec, base=base, source=source, text=text)
     sweep.check()
     return sweep
 
@@ -302,12 +304,4 @@ def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = Non
 def load_sweep(path: str | Path) -> Sweep:
     """Read and check a sweep file; raise :class:`SweepError`."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SweepError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise SweepError(f"{path}: is a directory, not a sweep file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SweepError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
-    return loads_sweep(text, source=str(path), directory=path.parent)
+    return loads_sweep(read_text(path, "sweep", SweepError), source=str(path), directory=path.parent)

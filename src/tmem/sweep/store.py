@@ -43,8 +43,8 @@ class ResultStore:
         self.metrics = tuple(sweep.spec.metrics)
 
     @classmethod
-    def open(cls, out: str | Path, sweep: Sweep, text: str) -> "ResultStore":
-        """Open ``out`` for ``sweep`` (whose file reads ``text``): new, empty, or holding this sweep."""
+    def open(cls, out: str | Path, sweep: Sweep) -> "ResultStore":
+        """Open ``out`` for ``sweep``: new, empty, or holding this sweep's results so far."""
         out = Path(out)
         _check_directory(out, sweep)
         store = cls(out, sweep)
@@ -53,7 +53,7 @@ class ResultStore:
             for stale in (out / PARTS).glob(".*.tmp"):  # a part whose writing was cut off
                 stale.unlink()
             if not (out / "sweep.json").exists():
-                (out / "sweep.toml").write_text(text, encoding="utf-8")
+                (out / "sweep.toml").write_text(sweep.text, encoding="utf-8")
                 identity = {"fingerprint": sweep.fingerprint, "cases": sweep.n_cases, "name": sweep.name, "tmem": __version__}
                 _write_atomically(out / "sweep.json", lambda tmp: tmp.write_text(json.dumps(identity, indent=2) + "\n"))
         except OSError as exc:
