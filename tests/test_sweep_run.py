@@ -182,11 +182,12 @@ def test_ctrl_c_on_the_command_then_the_same_command_finishes(tmp_path):
     sweep_file.write_text(ENCOUNTERS.format(cases=200, batch=4).replace("0.001", "0.0002"))
     out = tmp_path / "out"
     command = [sys.executable, "-m", "tmem", "sweep", str(sweep_file), "--out", str(out), "--workers", "2"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Ctrl-C in a terminal reaches the whole process group: the command and its workers.
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.monotonic() + 120
     while not list((out / "parts").glob("part-*.parquet")) and time.monotonic() < deadline:
         time.sleep(0.2)
-    process.send_signal(signal.SIGINT)
+    os.killpg(process.pid, signal.SIGINT)
     _, stderr = process.communicate(timeout=60)
     assert process.returncode == 130, stderr
     assert "run the same command again" in stderr and "Traceback" not in stderr

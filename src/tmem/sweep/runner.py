@@ -10,17 +10,22 @@ cluster's workers need tmem installed, in the same version.
 Nothing is lost when a sweep stops early: on Ctrl-C the rows received are
 written before :class:`SweepInterrupted` is raised; a killed worker's tasks
 are run again by Dask on the others; after a killed client, the parts on
-disk are whole.  The same command then runs only what is missing.  A task
-that fails as a whole (its worker killed again and again) gives its cases
-rows with the error, like a case that raises.
+disk are whole; tasks the cluster loses (a scheduler gone, a connection
+closed) leave their cases without rows.  The same command then runs only
+what is missing.  A task that fails as a whole for its own sake (its worker
+killed again and again by it) gives its cases rows with the error, like a
+case that raises.
 """
 
 from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import CancelledError
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,10 +43,15 @@ FLUSH_ROWS = 2000
 
 
 class SweepInterrupted(Exception):
-    """The sweep was stopped (Ctrl-C) after writing the rows it had; ``done`` of ``total`` cases are saved."""
+    """The sweep stopped early after writing the rows it had; ``done`` of ``total`` cases are saved.
 
-    def __init__(self, done: int, total: int):
-        super().__init__(f"interrupted: {done} of {total} cases saved; run the same command again to go on")
+    Raised on Ctrl-C, and when the cluster lost tasks (a scheduler gone, a
+    connection closed): their cases have no rows and run when the sweep is
+    started again.
+    """
+
+    def __init__(self, done: int, total: int, why: str = "interrupted"):
+        super().__init__(f"{why}: {done} of {total} cases saved; run the same command again to go on")
         self.done = done
         self.total = total
 
@@ -71,14 +81,23 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
         finally:
             client.close()
         return
-    cluster = LocalCluster(
-        n_workers=workers or os.cpu_count() or 1,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        silence_logs=logging.ERROR,
-        env={"NUMBA_NUM_THREADS": "1"},  # one process per core; no threads within
-    )  # fmt: skip
+    # Ctrl-C reaches every process of the terminal's group.  The worker processes are started with
+    # SIGINT ignored (they inherit it), so that only this process answers it: it saves the rows it
+    # has and shuts the cluster down, instead of every worker dying with a traceback.
+    main_thread = threading.current_thread() is threading.main_thread()  # where signals can be handled
+    interrupt = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
+    try:
+        cluster = LocalCluster(
+            n_workers=workers or os.cpu_count() or 1,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            silence_logs=logging.ERROR,
+            env={"NUMBA_NUM_THREADS": "1"},  # one process per core; no threads within
+        )  # fmt: skip
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGINT, interrupt)
     client = Client(cluster)
     try:
         yield client
@@ -130,6 +149,7 @@ def run_sweep(
         progress(done, sweep.n_cases)
     if todo:
         waiting: list[dict] = []
+        lost = ""
         last_flush = time.perf_counter()
         with dask_client(scheduler, workers) as client:
             from dask.distributed import as_completed
@@ -142,18 +162,24 @@ def run_sweep(
                     chunk = futures.pop(future)
                     try:
                         waiting += future.result()
-                    except Exception as exc:  # the task as a whole failed: its cases get the error
+                        ran += len(chunk)
+                    except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
+                        lost = f"{exc.__class__.__name__} from the cluster ({' '.join(str(exc).split())})"
+                    except Exception as exc:  # e.g. a worker killed again and again by this chunk
                         waiting += _failed_rows(chunk, metrics, exc)
-                    ran += len(chunk)
-                    if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS or not futures:
+                        ran += len(chunk)
+                    if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS:
                         store.add(waiting)
                         waiting, last_flush = [], time.perf_counter()
                     if progress:
                         progress(done + ran, sweep.n_cases)
+                store.add(waiting)
             except KeyboardInterrupt:
                 store.add(waiting)
                 client.cancel(list(futures))
                 raise SweepInterrupted(done + ran, sweep.n_cases) from None
+        if lost:
+            raise SweepInterrupted(done + ran, sweep.n_cases, why=f"tasks lost, {lost}")
     table = store.finish()
     write_report(table, sweep, out)
     return SweepOutcome(table=table, ran=ran, failed=int(table["error"].notna().sum()), seconds=time.perf_counter() - started)
