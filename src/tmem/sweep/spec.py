@@ -40,6 +40,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 import re
 import tomllib
 from dataclasses import dataclass
@@ -164,14 +165,15 @@ class SweepFile(StrictModel):
                 if path in where and where[path].split("[")[0] != kind:
                     raise FieldError(f"{table_name}.{path}", f"is also given in {where[path]}")
                 where.setdefault(path, table_name)
-        total = max(len(self.case), 1) * _product([len(v) for v in self.grid.values()]) * (self.cases or 1)
-        if total > MAX_CASES:
-            raise FieldError("cases", f"the sweep has {total} cases; at most {MAX_CASES}")
+        if self.n_cases > MAX_CASES:
+            raise FieldError("cases", f"the sweep has {self.n_cases} cases; at most {MAX_CASES}")
         return self
 
-
-def _product(sizes: list[int]) -> int:
-    return int(np.prod(sizes, dtype=np.int64)) if sizes else 1
+    @property
+    def n_cases(self) -> int:
+        """Explicit cases (at least one) × grid points × random draws."""
+        grid_points = math.prod(len(v) for v in self.grid.values())
+        return max(len(self.case), 1) * grid_points * (self.cases or 1)
 
 
 @dataclass(frozen=True)
@@ -210,7 +212,7 @@ class Sweep:
 
     @property
     def n_cases(self) -> int:
-        return max(len(self.spec.case), 1) * _product([len(v) for v in self.spec.grid.values()]) * (self.spec.cases or 1)
+        return self.spec.n_cases
 
     def _settings(self) -> list[dict[str, Any]]:
         """Every explicit case times every grid point, in case order."""
