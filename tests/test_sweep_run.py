@@ -216,3 +216,23 @@ def test_statistics_against_closed_forms():
     assert c["n"] == 4 and c["coupled_percent"] == 75.0
     assert c["uncoupled_percent"] == pytest.approx(200 / 3) and c["uncouple_delay_median"] == 2.0
     assert c["couple_time_median"] == 4.0
+
+
+def test_tasks_the_cluster_loses_leave_their_cases_to_run_again(tmp_path, monkeypatch):
+    sweep = encounters(cases=6, batch=3)
+    real = run_chunk
+
+    def flaky(base, cases, metrics):  # the first chunk's connection drops
+        if cases[0].index == 0:
+            raise ConnectionResetError("connection to the worker closed")
+        return real(base, cases, metrics)
+
+    monkeypatch.setattr("tmem.sweep.runner.run_chunk", flaky)
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as threads:
+        with pytest.raises(SweepInterrupted, match="tasks lost, ConnectionResetError"):
+            run_sweep(sweep, tmp_path / "out", scheduler=threads.scheduler_address)
+        parts = pd.concat([pd.read_parquet(p) for p in (tmp_path / "out" / "parts").glob("part-*.parquet")])
+        assert sorted(parts["case"]) == list(range(3, 12)) and parts["error"].isna().all()
+        monkeypatch.setattr("tmem.sweep.runner.run_chunk", real)
+        resumed = run_sweep(sweep, tmp_path / "out", scheduler=threads.scheduler_address)
+    assert resumed.ran == 3 and list(resumed.table["case"]) == list(range(12))
