@@ -5,6 +5,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -98,7 +99,7 @@ metrics = ["rms_change_percent", "formation.distance_error.max", "pairs.0.couple
 "interaction.c_max" = [0.1, 0.2]
 """,
         source="t.toml",
-        directory=__import__("pathlib").Path("tests"),
+        directory=Path(__file__).parent,
     )
     metrics = tuple(sweep.spec.metrics)
     chunks = plan_chunks(sweep.base, sweep.cases(), metrics, None)

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tmem.sweep import SweepError, loads_sweep
+from tmem.sweep import SweepError, load_sweep, loads_sweep
 from tmem.sweep.spec import SCALAR_METRICS
 
 BASE = """
@@ -156,7 +156,7 @@ def test_the_command_refuses_a_directory_of_another_sweep(tmp_path):
 
 
 def test_example_sweeps_are_valid():
-    for path in sorted(Path("examples/sweeps").glob("*.toml")):
-        from tmem.sweep import load_sweep
-
+    paths = sorted((Path(__file__).parent.parent / "examples" / "sweeps").glob("*.toml"))
+    assert len(paths) >= 3
+    for path in paths:
         assert load_sweep(path).n_cases >= 1
