@@ -52,7 +52,9 @@ class BatchResult:
 LANES = 8
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy")
+# fastmath "contract" only: the multiply-adds may fuse (one rounding instead of two); NaN and
+# infinity keep their meaning, which the flag logic relies on (r_before is NaN after a skip).
+@numba.njit(cache=True, parallel=True, error_model="numpy", fastmath={"contract"})
 def _run_batch(
     e0, n_steps, dt, command_step, ad, bd, gains, function, couples, at_crossing, reach, d_t, eps, c_max,
     e_end, min_dist, couple_step, uncouple_step,
