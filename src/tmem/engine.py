@@ -209,7 +209,8 @@ def _advance_source(
                     shift2 += delta * delta
             moved = max(moved, shift2 if active[i] else 0.0)
         if use_lists and (rebuild or np.sqrt(moved) > 0.5 * skin):
-            # The caller builds the lists (with p_ref = P* now) and resumes at step k.
+            # The caller builds the lists from p_ref = P* now, and resumes at step k.
+            p_ref[:] = p_star
             return k, next_command, next_record, n_events, _LISTS_STALE
         # 3. non-formation neighbours: each listed pair once, its pushes equal and opposite
         u[:] = 0.0
@@ -353,7 +354,7 @@ def _advance_source(
                     ui = u[i, a]
                     for m in range(4):
                         x[i, a, m] = ad[m, 0] * x0 + ad[m, 1] * x1 + ad[m, 2] * x2 + ad[m, 3] * x3 + bd[m] * ui
-                    if box[a] > 0.0:
+                    if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor below is 0
                         x[i, a, 0] -= box[a] * np.floor(x[i, a, 0] / box[a])
     return k_stop, next_command, next_record, n_events, 0
 
@@ -475,9 +476,8 @@ def simulate(
     builds = 0
 
     def build_lists() -> None:
-        """Build the neighbour lists (half rows) from the agents' P* now, growing the index arrays if needed."""
+        """Build the neighbour lists (half rows) from ``p_ref``, growing the index arrays if needed."""
         nonlocal builds, full_idx, nbr_idx
-        p_ref[:] = x @ (gains / gains[0])
         cutoff = ia.reach + scenario.neighbors.skin
         needed, slots = verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
         if needed > len(full_idx):
@@ -488,6 +488,7 @@ def simulate(
         builds += 1
 
     if use_lists:
+        p_ref[:] = x @ (gains / gains[0])  # P* (6) at the start
         build_lists()
 
     next_command = next_record = n_events = 0

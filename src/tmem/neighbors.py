@@ -106,12 +106,13 @@ def _cells(points, active, cutoff, box):
 
 
 @numba.njit(cache=True)
-def _forward_offsets(shape):
-    """Cell offsets that visit every pair of neighbouring cells once: the cell itself, then the
-    offsets in {-1, 0, 1}^axes whose first non-zero entry is +1 (only 0 along an axis of one cell)."""
-    axes = shape.shape[0]
-    offsets = np.zeros((3**axes, axes), dtype=np.int64)
-    n = 1  # row 0: the cell itself
+def _forward_rows(shape):
+    """Offsets of the rows of cells (along all axes but the last) that visit every pair of
+    neighbouring rows once: the row itself, then the offsets in {-1, 0, 1}^(axes - 1) whose first
+    non-zero entry is +1 (only 0 along an axis of one cell)."""
+    axes = shape.shape[0] - 1
+    rows = np.zeros((3**axes, axes), dtype=np.int64)
+    n = 1  # row 0: the row itself
     for code in range(3**axes):
         first = 0
         valid = True
@@ -119,14 +120,14 @@ def _forward_offsets(shape):
         for a in range(axes - 1, -1, -1):
             o = rest % 3 - 1
             rest //= 3
-            offsets[n, a] = o
+            rows[n, a] = o
             if o != 0 and shape[a] == 1:
                 valid = False
             if o != 0:
                 first = o  # the last one set is the first axis's
         if valid and first == 1:
             n += 1
-    return offsets[:n]
+    return rows[:n]
 
 
 @numba.njit(cache=True)
@@ -136,9 +137,10 @@ def verlet_lists(points, active, cutoff, box, ptr, idx, order):
     Fills ``order[:m]`` with the agents in cell order (``m`` active agents) and,
     for each slot ``s``, row ``ptr[s]:ptr[s + 1]`` of ``idx`` with the slots of
     the agents within ``cutoff`` of agent ``order[s]``, sorted by agent index.
-    Each pair of neighbouring cells is searched once.  Returns ``(needed, m)``;
-    if ``needed`` exceeds ``len(idx)`` the rows are not filled and the caller
-    must grow ``idx`` and call again.
+    Each pair of neighbouring cells is searched once; the cells along the last
+    axis are contiguous in slots, so a row of them is searched in one run.
+    Returns ``(needed, m)``; if ``needed`` exceeds ``len(idx)`` the rows are
+    not filled and the caller must grow ``idx`` and call again.
     """
     n, axes = points.shape
     cell_of, shape, start, cells_order = _cells(points, active, cutoff, box)
@@ -147,44 +149,74 @@ def verlet_lists(points, active, cutoff, box, ptr, idx, order):
     local = np.empty((m, axes))  # the points in slot order: neighbours close in memory
     for s in range(m):
         local[s] = points[cells_order[s]]
-    offsets = _forward_offsets(shape)
+    rows = _forward_rows(shape)
+    last = axes - 1
+    width = shape[last]
     cutoff2 = cutoff * cutoff
     capacity = idx.shape[0] // 2
-    first = np.empty(capacity, dtype=np.int32)  # the pairs found, by slot
-    second = np.empty(capacity, dtype=np.int32)
+    first = np.empty(capacity + 1, dtype=np.int32)  # the pairs found, by slot (one spare entry)
+    second = np.empty(capacity + 1, dtype=np.int32)
     count = np.zeros(m + 1, dtype=np.int64)
     n_pairs = 0
-    home = np.zeros(axes, dtype=np.int64)
+    home = np.zeros(axes, dtype=np.int64)  # the cell's indices along the axes, counted up as c goes
+    home[last] = -1
+    runs = np.empty((2, 2), dtype=np.int64)  # up to two runs of cells along the last axis
     for c in range(start.shape[0] - 1):
-        rest = c
-        for a in range(axes - 1, -1, -1):
-            home[a] = rest % shape[a]
-            rest //= shape[a]
-        for o in range(offsets.shape[0]):
-            other = 0
-            for a in range(axes):
-                k = home[a] + offsets[o, a]
-                if box[a] > 0.0:
-                    k %= shape[a]
-                elif k < 0 or k >= shape[a]:
-                    other = -1
-                    break
-                other = other * shape[a] + k
-            if other < 0:
+        a = last
+        home[a] += 1
+        while home[a] == shape[a]:
+            home[a] = 0
+            a -= 1
+            home[a] += 1
+        if start[c] == start[c + 1]:
+            continue
+        for r in range(rows.shape[0]):
+            base = 0  # the neighbouring row's first cell
+            for a in range(last):
+                k = home[a] + rows[r, a]
+                if k < 0 or k >= shape[a]:
+                    if box[a] == 0.0:
+                        base = -1
+                        break
+                    k += shape[a] if k < 0 else -shape[a]  # round the periodic axis
+                base = base * shape[a] + k
+            if base < 0:
                 continue
+            base *= width
+            # cells home - 1 .. home + 1 along the last axis (from home itself in the same row)
+            low = home[last] if r == 0 else home[last] - 1
+            high = home[last] + 1
+            if width == 1:
+                low, high = 0, 0
+            n_runs = 1
+            runs[0, 0], runs[0, 1] = low, high
+            if box[last] == 0.0:
+                runs[0, 0], runs[0, 1] = max(low, 0), min(high, width - 1)
+            elif low < 0:
+                runs[0, 0], runs[1, 0], runs[1, 1] = 0, width - 1, width - 1
+                n_runs = 2
+            elif high == width:
+                runs[0, 1], runs[1, 0], runs[1, 1] = width - 1, 0, 0
+                n_runs = 2
             for s in range(start[c], start[c + 1]):
-                for t in range(s + 1 if o == 0 else start[other], start[other + 1]):
-                    r2 = 0.0
-                    for a in range(axes):
-                        delta = nearest_image(local[t, a] - local[s, a], box[a])
-                        r2 += delta * delta
-                    if r2 < cutoff2:
-                        if n_pairs < capacity:
-                            first[n_pairs] = s
-                            second[n_pairs] = t
-                        n_pairs += 1
-                        count[s + 1] += 1
-                        count[t + 1] += 1
+                found = 0
+                for q in range(n_runs):
+                    t_first = start[base + runs[q, 0]]
+                    if r == 0 and runs[q, 0] == home[last]:
+                        t_first = s + 1  # in its own cell, each pair once
+                    for t in range(t_first, start[base + runs[q, 1] + 1]):
+                        r2 = 0.0
+                        for a in range(axes):
+                            delta = nearest_image(local[t, a] - local[s, a], box[a])
+                            r2 += delta * delta
+                        close = r2 < cutoff2
+                        slot = min(n_pairs, capacity)  # past capacity, only counted
+                        first[slot] = s
+                        second[slot] = t
+                        n_pairs += close
+                        found += close
+                        count[t + 1] += close
+                count[s + 1] += found
     ptr[: m + 1] = np.cumsum(count)
     if ptr[m] > idx.shape[0]:
         return ptr[m], m
