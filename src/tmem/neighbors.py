@@ -28,7 +28,7 @@ def all_pairs(n_agents: int) -> tuple[np.ndarray, np.ndarray]:
     """Half rows listing every pair once: row ``i`` holds ``i + 1, ..., n_agents - 1``."""
     lengths = np.arange(n_agents - 1, -1, -1)
     ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
-    idx = np.concatenate([np.arange(i + 1, n_agents) for i in range(n_agents)] or [[]]).astype(np.int32)
+    idx = np.concatenate([np.arange(i + 1, n_agents) for i in range(n_agents)] or [[]]).astype(np.uint32)
     return ptr, idx
 
 
