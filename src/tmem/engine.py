@@ -43,7 +43,7 @@ import numpy as np
 from . import coupling, interaction
 from .control import modal_gains
 from .model import state_matrices, zero_order_hold
-from .neighbors import all_pairs, half_rows, nearest_image, spatial_order, verlet_lists
+from .neighbors import all_pairs, nearest_image, pair_list, spatial_order, verlet_lists
 from .scenario import Scenario
 from .setup import Setup, build
 
@@ -149,74 +149,60 @@ def _is_partner(adj_ptr, adj_idx, i, j):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _neighbour_pushes(
-    p_star, x, active, nbr_ptr, nbr_idx, adj_ptr, adj_idx, box, function, k_p, reach, c_max, u, closest
-):  # fmt: skip
+def _neighbour_pushes(p_star, x, active, pairs, n_pairs, adj_ptr, adj_idx, box, function, k_p, reach, c_max, u, closest):
     """Step 3: set ``u`` to the summed pushes of every agent's non-formation neighbours.
 
-    Each listed pair (half rows ``nbr_ptr``, ``nbr_idx``: row ``i`` holds
-    neighbours ``j > i``) is taken once, and its pushes, equal and opposite, go
+    Each listed pair ``(i, j)``, ``i < j`` (the first ``n_pairs`` rows of
+    ``pairs``, sorted), is taken once, and its pushes, equal and opposite, go
     to both agents: in this order every agent gets its neighbours' pushes by
     increasing index, whatever the lists.  ``closest[0]`` keeps the smallest
     squared distance ``|P_j - P_i|^2`` of a pair within reach.
     """
-    n_agents = p_star.shape[0]
     n_axes = len(box)  # a tuple: compiled for each number of axes
     reach2 = reach * reach
     u[:] = 0.0
     nearest2 = closest[0]
-    for i in range(n_agents):
-        if not active[i]:
+    for e in range(n_pairs):  # one loop over all pairs: no branch per agent
+        i = pairs[e, 0]
+        j = pairs[e, 1]
+        if not (active[i] and active[j]):
             continue
-        u0 = u[i, 0]  # the pushes of neighbours j < i, summed so far
-        u1 = u[i, 1] if n_axes > 1 else 0.0
-        u2 = u[i, 2] if n_axes > 2 else 0.0
-        has_partners = adj_ptr[i] < adj_ptr[i + 1]
-        for entry in range(nbr_ptr[i], nbr_ptr[i + 1]):
-            j = nbr_idx[entry]
-            if not active[j]:
-                continue
-            d0 = nearest_image(p_star[j, 0] - p_star[i, 0], box[0])
-            r2 = d0 * d0
-            d1 = 0.0
-            d2 = 0.0
-            if n_axes > 1:
-                d1 = nearest_image(p_star[j, 1] - p_star[i, 1], box[1])
-                r2 += d1 * d1
-            if n_axes > 2:
-                d2 = nearest_image(p_star[j, 2] - p_star[i, 2], box[2])
-                r2 += d2 * d2
-            if r2 >= reach2 or r2 == 0.0:
-                continue
-            if has_partners and _is_partner(adj_ptr, adj_idx, i, j):
-                continue
-            dist2 = 0.0
-            for a in range(n_axes):
-                delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
-                dist2 += delta * delta
-            nearest2 = min(nearest2, dist2)
-            r = np.sqrt(r2)
-            push = interaction.pair_control(function, r, 0, k_p, reach, 0.0, c_max) / r
-            u0 += push * d0
-            u[j, 0] -= push * d0
-            if n_axes > 1:
-                u1 += push * d1
-                u[j, 1] -= push * d1
-            if n_axes > 2:
-                u2 += push * d2
-                u[j, 2] -= push * d2
-        u[i, 0] = u0
+        d0 = nearest_image(p_star[j, 0] - p_star[i, 0], box[0])
+        r2 = d0 * d0
+        d1 = 0.0
+        d2 = 0.0
         if n_axes > 1:
-            u[i, 1] = u1
+            d1 = nearest_image(p_star[j, 1] - p_star[i, 1], box[1])
+            r2 += d1 * d1
         if n_axes > 2:
-            u[i, 2] = u2
+            d2 = nearest_image(p_star[j, 2] - p_star[i, 2], box[2])
+            r2 += d2 * d2
+        if r2 >= reach2 or r2 == 0.0:
+            continue
+        if adj_ptr[i] < adj_ptr[i + 1] and _is_partner(adj_ptr, adj_idx, i, j):
+            continue
+        dist2 = 0.0
+        for a in range(n_axes):
+            delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
+            dist2 += delta * delta
+        nearest2 = min(nearest2, dist2)
+        r = np.sqrt(r2)
+        push = interaction.pair_control(function, r, 0, k_p, reach, 0.0, c_max) / r
+        u[i, 0] += push * d0
+        u[j, 0] -= push * d0
+        if n_axes > 1:
+            u[i, 1] += push * d1
+            u[j, 1] -= push * d1
+        if n_axes > 2:
+            u[i, 2] += push * d2
+            u[j, 2] -= push * d2
     closest[0] = nearest2
 
 
 def _advance_source(
     k_start, k_stop, n_steps, record_every,
     x, active, x_start, ad, bd, gains, function, couples, at_crossing, pair_function, k_p, reach, eps, c_max, box,
-    use_lists, skin, nbr_ptr, nbr_idx, p_ref,
+    use_lists, skin, pairs, n_pairs, p_ref,
     edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, adj_ptr, adj_idx, edge_min, closest,
     cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
     rec_slots, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
@@ -279,7 +265,7 @@ def _advance_source(
             return k, next_command, next_record, n_events, _LISTS_STALE
         # 3. non-formation neighbours
         _neighbour_pushes(
-            p_star, x, active, nbr_ptr, nbr_idx, adj_ptr, adj_idx, box, pair_function, k_p, reach, c_max, u, closest
+            p_star, x, active, pairs, n_pairs, adj_ptr, adj_idx, box, pair_function, k_p, reach, c_max, u, closest
         )  # fmt: skip
         # 4. formation pairs
         for e in range(n_edges):
@@ -461,13 +447,13 @@ def simulate(
     method = scenario.neighbors.method
     use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
     if use_lists:
-        nbr_ptr = np.zeros(n_agents + 1, dtype=np.int64)
-        nbr_idx = np.empty(8 * n_agents, dtype=np.uint32)  # unsigned: no negative-index check in the loop
+        pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)  # unsigned: no negative-index check in the loop
         full_ptr = np.zeros(n_agents + 1, dtype=np.int64)
         full_idx = np.empty(16 * n_agents, dtype=np.int32)
         cells = np.empty(n_agents, dtype=np.int64)
     else:
-        nbr_ptr, nbr_idx = all_pairs(n_agents)
+        pairs = all_pairs(n_agents)
+    n_pairs = len(pairs)
     advance = _advance_threaded if n_agents >= LARGE_SWARM else _advance_serial
 
     cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt, slot)
@@ -496,15 +482,15 @@ def simulate(
     builds = 0
 
     def build_lists() -> None:
-        """Build the neighbour lists (half rows) from ``p_ref``, growing the index arrays if needed."""
-        nonlocal builds, full_idx, nbr_idx
+        """Build the neighbour lists from ``p_ref`` (each pair once), growing the arrays if needed."""
+        nonlocal builds, full_idx, pairs, n_pairs
         cutoff = ia.reach + scenario.neighbors.skin
         needed, slots = verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
         if needed > len(full_idx):
             full_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
-            nbr_idx = np.empty(len(full_idx) // 2, dtype=np.uint32)
+            pairs = np.empty((len(full_idx) // 2, 2), dtype=np.uint32)
             verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
-        half_rows(full_ptr, full_idx, cells, slots, nbr_ptr, nbr_idx)
+        n_pairs = pair_list(full_ptr, full_idx, cells, slots, pairs)
         builds += 1
 
     if use_lists:
@@ -523,7 +509,7 @@ def simulate(
             interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function), ia.switch_at == "crossing",
             interaction.REPULSION if interaction.uses_coupling(ia.function) else interaction.FUNCTIONS.index(ia.function),
             gains[0], ia.reach, ia.eps, ia.c_max, tuple(setup.box.tolist()),
-            use_lists, scenario.neighbors.skin, nbr_ptr, nbr_idx, p_ref,
+            use_lists, scenario.neighbors.skin, pairs, n_pairs, p_ref,
             edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, adj_ptr, adj_idx, edge_min, closest,
             cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
             rec_slots, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,

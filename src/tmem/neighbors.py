@@ -9,10 +9,11 @@ compressed rows (``ptr``, ``idx``), sorted by index:
   moved more than ``skin / 2`` since the last build.  No pair that is not
   listed can come within ``R + R_j`` before then.
 
-The step loop takes *half* rows: row ``i`` lists each neighbour ``j > i``
-once, and the pair's pushes, equal and opposite, go to both agents.  Agent
-``i`` thus gets its neighbours' contributions in the order of their indices
-with either kind of list: the two give the same bits.  The loop numbers the
+The step loop takes each candidate pair once, as a list of ``(i, j)`` with
+``i < j`` sorted by ``i`` then ``j``, and gives the pair's pushes, equal and
+opposite, to both agents.  Every agent thus gets its neighbours'
+contributions in the order of their indices with either kind of list: the
+two give the same bits.  The loop numbers the
 agents in a spatial order (:func:`spatial_order`), so that neighbours are
 close in memory.  With a periodic box, differences are taken to the nearest
 image.
@@ -24,12 +25,9 @@ import numba
 import numpy as np
 
 
-def all_pairs(n_agents: int) -> tuple[np.ndarray, np.ndarray]:
-    """Half rows listing every pair once: row ``i`` holds ``i + 1, ..., n_agents - 1``."""
-    lengths = np.arange(n_agents - 1, -1, -1)
-    ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
-    idx = np.concatenate([np.arange(i + 1, n_agents) for i in range(n_agents)] or [[]]).astype(np.uint32)
-    return ptr, idx
+def all_pairs(n_agents: int) -> np.ndarray:
+    """Every pair ``(i, j)``, ``i < j``, once, sorted: shape (pairs, 2), unsigned."""
+    return np.stack(np.triu_indices(n_agents, k=1), axis=1).astype(np.uint32)
 
 
 @numba.njit(cache=True)
@@ -240,29 +238,30 @@ def verlet_lists(points, active, cutoff, box, ptr, idx, order):
 
 
 @numba.njit(cache=True)
-def half_rows(ptr, idx, order, m, half_ptr, half_idx):
-    """Verlet lists (:func:`verlet_lists`) as half rows in the agents' own numbering.
+def pair_list(ptr, idx, order, m, pairs):
+    """The pairs of Verlet lists (:func:`verlet_lists`), each once, in the points' own numbering.
 
-    Row ``i`` of ``(half_ptr, half_idx)`` lists the neighbours ``j > i`` of agent
-    ``i``, ascending; an agent without a slot (inactive) has an empty row.
-    ``half_idx`` must hold ``ptr[m] // 2`` entries.
+    Fills the rows of ``pairs`` (at least ``ptr[m] // 2``) with ``(i, j)``,
+    ``i < j``, sorted by ``i`` then ``j``, and returns how many there are.
     """
-    half_ptr[:] = 0
+    start = np.zeros(order.shape[0] + 1, dtype=np.int64)
     for s in range(m):
         i = order[s]
         for e in range(ptr[s], ptr[s + 1]):
             if order[idx[e]] > i:
-                half_ptr[i + 1] += 1
-    for i in range(half_ptr.shape[0] - 1):
-        half_ptr[i + 1] += half_ptr[i]
+                start[i + 1] += 1
+    for i in range(order.shape[0]):
+        start[i + 1] += start[i]
     for s in range(m):
         i = order[s]
-        q = half_ptr[i]
+        q = start[i]
         for e in range(ptr[s], ptr[s + 1]):  # the row is sorted: its neighbours j > i come last
             j = order[idx[e]]
             if j > i:
-                half_idx[q] = j
+                pairs[q, 0] = i
+                pairs[q, 1] = j
                 q += 1
+    return start[-1]
 
 
 def spatial_order(points: np.ndarray, active: np.ndarray, side: float, box: np.ndarray) -> np.ndarray:
