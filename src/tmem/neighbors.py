@@ -245,22 +245,23 @@ def pair_list(ptr, idx, order, m, pairs):
     ``i < j``, sorted by ``i`` then ``j``, and returns how many there are.
     """
     start = np.zeros(order.shape[0] + 1, dtype=np.int64)
+    above = np.empty(m, dtype=np.int64)  # where each row's neighbours j > i begin: the row is sorted
     for s in range(m):
         i = order[s]
-        for e in range(ptr[s], ptr[s + 1]):
-            if order[idx[e]] > i:
-                start[i + 1] += 1
+        e = ptr[s]
+        while e < ptr[s + 1] and order[idx[e]] < i:
+            e += 1
+        above[s] = e
+        start[i + 1] = ptr[s + 1] - e
     for i in range(order.shape[0]):
         start[i + 1] += start[i]
     for s in range(m):
         i = order[s]
         q = start[i]
-        for e in range(ptr[s], ptr[s + 1]):  # the row is sorted: its neighbours j > i come last
-            j = order[idx[e]]
-            if j > i:
-                pairs[q, 0] = i
-                pairs[q, 1] = j
-                q += 1
+        for e in range(above[s], ptr[s + 1]):
+            pairs[q, 0] = i
+            pairs[q, 1] = order[idx[e]]
+            q += 1
     return start[-1]
 
 
