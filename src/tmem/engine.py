@@ -24,8 +24,11 @@ paper's per-axis model (2) with the same gains.  Each step ``k`` (time
 
 A removed agent stops where it is, and no longer interacts (a lost
 vehicle); an added agent starts from its ``[[agents]]`` entry.  The loop is
-compiled with Numba (threads over agents for large swarms) and runs in
-chunks, so that a caller can show progress between them.
+compiled with Numba and runs in chunks, so that a caller can show progress
+between them.  It keeps the agents in *slots*, numbered in a spatial order
+so that neighbours are close in memory, and takes each neighbouring pair
+once (:mod:`tmem.neighbors`); the per-agent steps use threads in large
+swarms.
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ import numpy as np
 from . import coupling, interaction
 from .control import modal_gains
 from .model import state_matrices, zero_order_hold
-from .neighbors import all_pairs, nearest_image, verlet_lists
+from .neighbors import all_pairs, nearest_image, pair_list, spatial_order, verlet_lists
 from .scenario import Scenario
 from .setup import Setup, build
 
@@ -139,22 +142,80 @@ class Trajectory:
         return self.setup.d_t
 
 
+@numba.njit(cache=True)
+def _is_partner(adj_ptr, adj_idx, i, j):
+    """Whether agents ``i`` and ``j`` are a formation pair (rows ``adj_ptr``, ``adj_idx`` of partners)."""
+    for e in range(adj_ptr[i], adj_ptr[i + 1]):
+        if adj_idx[e] == j:
+            return True
+    return False
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _neighbour_pushes(p_star, x, active, pairs, n_pairs, adj_ptr, adj_idx, box, function, k_p, reach, c_max, u, closest):
+    """Step 3: set ``u`` to the summed pushes of every agent's non-formation neighbours.
+
+    Each listed pair ``(i, j)``, ``i < j`` (the first ``n_pairs`` rows of
+    ``pairs``, sorted), is taken once, and its pushes, equal and opposite, go
+    to both agents: in this order every agent gets its neighbours' pushes by
+    increasing index, whatever the lists.  ``closest[0]`` keeps the smallest
+    squared distance ``|P_j - P_i|^2`` of a pair within reach.
+    """
+    n_axes = len(box)  # a tuple: compiled for each number of axes
+    reach2 = reach * reach
+    u[:] = 0.0
+    nearest2 = closest[0]
+    for e in range(n_pairs):  # one loop over all pairs: no branch per agent
+        i = pairs[e, 0]
+        j = pairs[e, 1]
+        if not (active[i] and active[j]):
+            continue
+        d0 = nearest_image(p_star[j, 0] - p_star[i, 0], box[0])
+        r2 = d0 * d0
+        d1 = 0.0
+        d2 = 0.0
+        if n_axes > 1:
+            d1 = nearest_image(p_star[j, 1] - p_star[i, 1], box[1])
+            r2 += d1 * d1
+        if n_axes > 2:
+            d2 = nearest_image(p_star[j, 2] - p_star[i, 2], box[2])
+            r2 += d2 * d2
+        if r2 >= reach2 or r2 == 0.0:
+            continue
+        if adj_ptr[i] < adj_ptr[i + 1] and _is_partner(adj_ptr, adj_idx, i, j):
+            continue
+        dist2 = 0.0
+        for a in range(n_axes):
+            delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
+            dist2 += delta * delta
+        nearest2 = min(nearest2, dist2)
+        r = np.sqrt(r2)
+        push = interaction.pair_control(function, r, 0, k_p, reach, 0.0, c_max) / r
+        u[i, 0] += push * d0
+        u[j, 0] -= push * d0
+        if n_axes > 1:
+            u[i, 1] += push * d1
+            u[j, 1] -= push * d1
+        if n_axes > 2:
+            u[i, 2] += push * d2
+            u[j, 2] -= push * d2
+    closest[0] = nearest2
+
+
 def _advance_source(
     k_start, k_stop, n_steps, record_every,
     x, active, x_start, ad, bd, gains, function, couples, at_crossing, pair_function, k_p, reach, eps, c_max, box,
-    use_lists, skin, nbr_ptr, nbr_idx, order, n_slots, p_ref,
-    edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, adj_ptr, adj_idx, edge_min, agent_min,
+    use_lists, skin, pairs, n_pairs, p_ref,
+    edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, adj_ptr, adj_idx, edge_min, closest,
     cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
-    rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
+    rec_slots, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
     event_step, event_kind, event_i, event_j, event_action, n_events,
 ):  # fmt: skip
-    n_agents, n_axes, _ = x.shape
+    n_agents = x.shape[0]
+    n_axes = len(box)  # a tuple: the loop is compiled for each number of axes
     n_edges = edge_i.shape[0]
     p_star = np.empty((n_agents, n_axes))
-    slot_p_star = np.empty((n_slots, n_axes))  # P* and positions in slot order: neighbours close in memory
-    slot_position = np.empty((n_slots, n_axes))
     u = np.zeros((n_agents, n_axes))
-    moved = np.zeros(n_agents)
     d = np.empty(n_axes)
     v = np.empty(n_axes)
     reach2 = reach * reach
@@ -188,7 +249,8 @@ def _advance_source(
             event_action[n_events] = kind
             n_events += 1
             next_command += 1
-        # 2. corrected positions (6); neighbour lists
+        # 2. corrected positions (6); the largest shift of an active agent's P* since the lists were built
+        moved = 0.0
         for i in numba.prange(n_agents):
             shift2 = 0.0
             for a in range(n_axes):
@@ -199,61 +261,15 @@ def _advance_source(
                 if use_lists:
                     delta = nearest_image(p_star[i, a] - p_ref[i, a], box[a])
                     shift2 += delta * delta
-            moved[i] = shift2 if active[i] else 0.0
-        if use_lists and (rebuild or np.sqrt(moved.max()) > 0.5 * skin):
-            # The caller builds the lists (with p_ref = P* now) and resumes at step k.
+            moved = max(moved, shift2 if active[i] else 0.0)
+        if use_lists and (rebuild or np.sqrt(moved) > 0.5 * skin):
+            # The caller builds the lists from p_ref = P* now, and resumes at step k.
+            p_ref[:] = p_star
             return k, next_command, next_record, n_events, _LISTS_STALE
-        # 3. non-formation neighbours, agent by agent in slot order
-        for q in numba.prange(n_slots):
-            i = order[q]
-            for a in range(n_axes):
-                slot_p_star[q, a] = p_star[i, a]
-                slot_position[q, a] = x[i, a, 0]
-        for q in numba.prange(n_slots):
-            i = order[q]
-            u0 = 0.0
-            u1 = 0.0
-            u2 = 0.0
-            if active[i]:
-                for entry in range(nbr_ptr[q], nbr_ptr[q + 1]):
-                    t = nbr_idx[entry]
-                    j = order[t]
-                    if not active[j]:
-                        continue
-                    d0 = nearest_image(slot_p_star[t, 0] - slot_p_star[q, 0], box[0])
-                    r2 = d0 * d0
-                    d1 = 0.0
-                    d2 = 0.0
-                    if n_axes > 1:
-                        d1 = nearest_image(slot_p_star[t, 1] - slot_p_star[q, 1], box[1])
-                        r2 += d1 * d1
-                    if n_axes > 2:
-                        d2 = nearest_image(slot_p_star[t, 2] - slot_p_star[q, 2], box[2])
-                        r2 += d2 * d2
-                    if r2 >= reach2 or r2 == 0.0:
-                        continue
-                    partner = False
-                    for e in range(adj_ptr[i], adj_ptr[i + 1]):
-                        if adj_idx[e] == j:
-                            partner = True
-                    if partner:
-                        continue
-                    dist2 = 0.0
-                    for a in range(n_axes):
-                        delta = nearest_image(slot_position[t, a] - slot_position[q, a], box[a])
-                        dist2 += delta * delta
-                    if dist2 < agent_min[i]:
-                        agent_min[i] = dist2
-                    r = np.sqrt(r2)
-                    push = interaction.pair_control(pair_function, r, 0, k_p, reach, 0.0, c_max) / r
-                    u0 += push * d0
-                    u1 += push * d1
-                    u2 += push * d2
-            u[i, 0] = u0
-            if n_axes > 1:
-                u[i, 1] = u1
-            if n_axes > 2:
-                u[i, 2] = u2
+        # 3. non-formation neighbours
+        _neighbour_pushes(
+            p_star, x, active, pairs, n_pairs, adj_ptr, adj_idx, box, pair_function, k_p, reach, c_max, u, closest
+        )  # fmt: skip
         # 4. formation pairs
         for e in range(n_edges):
             i = edge_i[e]
@@ -318,8 +334,8 @@ def _advance_source(
                     u[i, a] = 0.0
         # 6. recording (before the step, with the control applied over it)
         if record_every > 0 and (k % record_every == 0 or k == n_steps):
-            for q in range(rec_agents.shape[0]):
-                i = rec_agents[q]
+            for q in range(rec_slots.shape[0]):
+                i = rec_slots[q]
                 rec_state[next_record, q] = x[i]
                 rec_control[next_record, q] = u[i]
                 rec_active[next_record, q] = active[i]
@@ -347,7 +363,7 @@ def _advance_source(
                     ui = u[i, a]
                     for m in range(4):
                         x[i, a, m] = ad[m, 0] * x0 + ad[m, 1] * x1 + ad[m, 2] * x2 + ad[m, 3] * x3 + bd[m] * ui
-                    if box[a] > 0.0:
+                    if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor below is 0
                         x[i, a, 0] -= box[a] * np.floor(x[i, a, 0] / box[a])
     return k_stop, next_command, next_record, n_events, 0
 
@@ -364,8 +380,8 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
     return steps
 
 
-def _commands(scenario: Scenario, edges: np.ndarray, dt: float):
-    """Commands as arrays: step, kind, and targets (pair indices, or the agent) in rows."""
+def _commands(scenario: Scenario, edges: np.ndarray, dt: float, slot: np.ndarray):
+    """Commands as arrays: step, kind, and targets (pair indices, or the agent's slot) in rows."""
     index = {(int(i), int(j)): e for e, (i, j) in enumerate(edges)}
     commands = sorted(scenario.commands, key=lambda cmd: cmd.time)
     step = np.array([int(round(cmd.time / dt)) for cmd in commands], dtype=np.int64)
@@ -373,7 +389,7 @@ def _commands(scenario: Scenario, edges: np.ndarray, dt: float):
     targets = []
     for cmd in commands:
         if cmd.agent is not None:
-            targets.append([cmd.agent])
+            targets.append([slot[cmd.agent]])
         else:
             targets.append([index[(min(i, j), max(i, j))] for i, j in cmd.targets or []])
     ptr = np.cumsum([0] + [len(t) for t in targets]).astype(np.int64)
@@ -414,15 +430,19 @@ def simulate(
     gains = modal_gains(m.kp, m.kd, m.g, c.r_l, c.im_l, c.im_r)
     setup: Setup = build(scenario)
 
-    x = setup.state.copy()
-    x_start = setup.state.copy()
-    active = setup.active.copy()
-    n_agents, n_axes, _ = x.shape
+    n_agents, n_axes, _ = setup.state.shape
+    # The loop keeps agent order[s] in slot s: a spatial order, with neighbours close in memory.
+    order = spatial_order(setup.state @ (gains / gains[0]), setup.active, ia.reach + scenario.neighbors.skin, setup.box)
+    slot = np.empty(n_agents, dtype=np.int64)
+    slot[order] = np.arange(n_agents)
+    x = setup.state[order]
+    x_start = x.copy()
+    active = setup.active[order]
     edges = setup.edges
     n_edges = len(edges)
-    edge_i = edges[:, 0].astype(np.int64).copy()
-    edge_j = edges[:, 1].astype(np.int64).copy()
-    adj_ptr, adj_idx = _partners(n_agents, edges)
+    edge_i = slot[edges[:, 0]]
+    edge_j = slot[edges[:, 1]]
+    adj_ptr, adj_idx = _partners(n_agents, np.stack([edge_i, edge_j], axis=1))
     flag = setup.flag.copy()
     armed = np.ones(n_edges, dtype=np.int64)
     r_before = np.full(n_edges, np.nan)  # |d| of each pair one step earlier; none before the first step
@@ -430,20 +450,22 @@ def simulate(
     method = scenario.neighbors.method
     use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
     if use_lists:
-        nbr_ptr = np.zeros(n_agents + 1, dtype=np.int64)
-        nbr_idx = np.empty(16 * n_agents, dtype=np.int32)
-        order = np.empty(n_agents, dtype=np.int64)
+        pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)  # unsigned: no negative-index check in the loop
+        full_ptr = np.zeros(n_agents + 1, dtype=np.int64)
+        full_idx = np.empty(16 * n_agents, dtype=np.int32)
+        cells = np.empty(n_agents, dtype=np.int64)
     else:
-        nbr_ptr, nbr_idx, order = all_pairs(n_agents)
-    n_slots = n_agents
+        pairs = all_pairs(n_agents)
+    n_pairs = len(pairs)
     advance = _advance_threaded if n_agents >= LARGE_SWARM else _advance_serial
 
-    cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt)
+    cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt, slot)
     n_steps = sim.n_steps
     steps = record_steps(n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
     rec_agents = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
     if not record:
         rec_agents = rec_agents[:0]
+    rec_slots = slot[rec_agents]
     rec_state = np.empty((len(steps), len(rec_agents), n_axes, 4))
     rec_control = np.empty((len(steps), len(rec_agents), n_axes))
     rec_active = np.empty((len(steps), len(rec_agents)), dtype=np.bool_)
@@ -458,24 +480,25 @@ def simulate(
     event_j = np.empty(max_events, dtype=np.int64)
     event_action = np.empty(max_events, dtype=np.int64)
     edge_min = np.full(n_edges, np.inf)
-    agent_min = np.full(n_agents, np.inf)
+    closest = np.full(1, np.inf)  # the smallest squared distance between neighbours so far
     p_ref = np.zeros((n_agents, n_axes))
     builds = 0
 
-    def build_lists(nbr_idx: np.ndarray) -> tuple[np.ndarray, int]:
-        """Build the neighbour lists from the agents' P* now; returns the (possibly grown) index array and slots."""
-        nonlocal builds
-        p_ref[:] = x @ (gains / gains[0])
+    def build_lists() -> None:
+        """Build the neighbour lists from ``p_ref`` (each pair once), growing the arrays if needed."""
+        nonlocal builds, full_idx, pairs, n_pairs
         cutoff = ia.reach + scenario.neighbors.skin
-        needed, slots = verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx, order)
-        if needed > len(nbr_idx):
-            nbr_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
-            verlet_lists(p_ref, active, cutoff, setup.box, nbr_ptr, nbr_idx, order)
+        needed, slots = verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
+        if needed > len(full_idx):
+            full_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
+            pairs = np.empty((len(full_idx) // 2, 2), dtype=np.uint32)
+            verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
+        n_pairs = pair_list(full_ptr, full_idx, cells, slots, pairs)
         builds += 1
-        return nbr_idx, slots
 
     if use_lists:
-        nbr_idx, n_slots = build_lists(nbr_idx)
+        p_ref[:] = x @ (gains / gains[0])  # P* (6) at the start
+        build_lists()
 
     next_command = next_record = n_events = 0
     k = 0
@@ -488,15 +511,15 @@ def simulate(
             x, active, x_start, ad, bd, gains,
             interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function), ia.switch_at == "crossing",
             interaction.REPULSION if interaction.uses_coupling(ia.function) else interaction.FUNCTIONS.index(ia.function),
-            gains[0], ia.reach, ia.eps, ia.c_max, setup.box,
-            use_lists, scenario.neighbors.skin, nbr_ptr, nbr_idx, order, n_slots, p_ref,
-            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, adj_ptr, adj_idx, edge_min, agent_min,
+            gains[0], ia.reach, ia.eps, ia.c_max, tuple(setup.box.tolist()),
+            use_lists, scenario.neighbors.skin, pairs, n_pairs, p_ref,
+            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, adj_ptr, adj_idx, edge_min, closest,
             cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
-            rec_agents, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
+            rec_slots, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
             event_step, event_kind, event_i, event_j, event_action, n_events,
         )  # fmt: skip
         if status == _LISTS_STALE:  # build the neighbour lists and go on from the same step
-            nbr_idx, n_slots = build_lists(nbr_idx)
+            build_lists()
             continue
         elapsed = _time.perf_counter() - started
         if progress is not None:
@@ -509,11 +532,11 @@ def simulate(
     events = []
     for e in range(n_events):
         kind = coupling.EVENT_KINDS[event_kind[e]]
-        agents = tuple(int(v) for v in (event_i[e], event_j[e]) if v >= 0)
+        agents = tuple(int(order[v]) for v in (event_i[e], event_j[e]) if v >= 0)
         action = next(name for name, code in _COMMAND_CODES.items() if code == event_action[e]) if kind == "command" else None
         events.append(Event(time=round(float(event_step[e] * sim.dt), 12), kind=kind, agents=agents, action=action))
 
-    min_neighbor = float(np.sqrt(agent_min.min())) if n_agents else np.inf
+    min_neighbor = float(np.sqrt(closest[0]))
     return Trajectory(
         scenario=scenario,
         setup=setup,
@@ -528,8 +551,8 @@ def simulate(
         interaction_distance=rec_dstar,
         min_distance=edge_min,
         min_neighbor_distance=min_neighbor,
-        final_state=x,
-        final_active=active,
+        final_state=x[slot],
+        final_active=active[slot],
         events=events,
         list_builds=builds,
     )

@@ -25,9 +25,10 @@ Notation, with ``reach = R + R_j``::
 The paper writes the saturation as ``max(s_d C_max, .)``; it is read here as
 ``|U| <= c_max`` with the sign set by the function.
 
-``K_P`` is the modal gain on position (the paper's ``K1``).  All functions are
-NumPy ufuncs compiled by Numba: they broadcast over arrays and are called
-unchanged, one pair at a time, by the compiled step loop.
+``K_P`` is the modal gain on position (the paper's ``K1``).  Each function is
+written once and compiled by Numba twice: as a NumPy ufunc that broadcasts
+over arrays, and as a scalar function that the compiled step loop calls one
+pair at a time (:func:`pair_control`).
 """
 
 from __future__ import annotations
@@ -67,26 +68,26 @@ def _spring(d: float, k_p: float, d_t: float) -> float:
     return k_p * (d - _sign(d) * d_t)
 
 
-@numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)
-def repulsion(d, k_p, reach, c_max):
+@numba.njit(cache=True)
+def _repulsion(d, k_p, reach, c_max):
     """Repulsion (8): ``K_P (d - s_d reach)`` for ``|d| < reach``, else 0; saturated."""
     return _saturate(_overlap(d, k_p, reach), c_max)
 
 
-@numba.vectorize(["float64(float64, float64, float64, float64, float64)"], cache=True)
-def attraction(d, k_p, reach, d_t, c_max):
+@numba.njit(cache=True)
+def _attraction(d, k_p, reach, d_t, c_max):
     """Attraction (Fig. 3): ``K_P (d - s_d d_t)`` for ``|d| < reach``, else 0; saturated."""
     return _saturate(_spring(d, k_p, d_t), c_max) if abs(d) < reach else 0.0
 
 
-@numba.vectorize(["float64(float64, int64, float64, float64, float64, float64)"], cache=True)
-def switching(d, f_en, k_p, reach, d_t, c_max):
+@numba.njit(cache=True)
+def _switching(d, f_en, k_p, reach, d_t, c_max):
     """Switching (10): f1 = repulsion (8) if ``f_en == 0``, else f2 = ``K_P (d - s_d d_t)``; saturated."""
     return _saturate(_overlap(d, k_p, reach) if f_en == 0 else _spring(d, k_p, d_t), c_max)
 
 
-@numba.vectorize(["float64(float64, int64, float64, float64, float64, float64)"], cache=True)
-def improved_switching(d, f_en, k_p, reach, d_t, c_max):
+@numba.njit(cache=True)
+def _improved_switching(d, f_en, k_p, reach, d_t, c_max):
     """Improved switching (11): the continuous f1 if ``f_en == 0``, else f2; saturated."""
     r = abs(d)
     if f_en != 0 or r < d_t:
@@ -98,16 +99,29 @@ def improved_switching(d, f_en, k_p, reach, d_t, c_max):
     return _saturate(u, c_max)
 
 
-@numba.njit(cache=True)
+def _ufunc(signature: str, scalar):
+    """The same function as a NumPy ufunc (the step loop calls the scalar one, which it can inline)."""
+    ufunc = numba.vectorize([signature], cache=True)(scalar.py_func)
+    ufunc.__doc__ = scalar.__doc__
+    return ufunc
+
+
+repulsion = _ufunc("float64(float64, float64, float64, float64)", _repulsion)
+attraction = _ufunc("float64(float64, float64, float64, float64, float64)", _attraction)
+switching = _ufunc("float64(float64, int64, float64, float64, float64, float64)", _switching)
+improved_switching = _ufunc("float64(float64, int64, float64, float64, float64, float64)", _improved_switching)
+
+
+@numba.njit(cache=True, inline="always")
 def pair_control(function, d, f_en, k_p, reach, d_t, c_max):
-    """Dispatch to the function with integer code ``function`` (see :data:`FUNCTIONS`)."""
+    """Dispatch to the function with integer code ``function`` (see :data:`FUNCTIONS`), for one pair."""
     if function == REPULSION:
-        return repulsion(d, k_p, reach, c_max)
+        return _repulsion(d, k_p, reach, c_max)
     if function == ATTRACTION:
-        return attraction(d, k_p, reach, d_t, c_max)
+        return _attraction(d, k_p, reach, d_t, c_max)
     if function == SWITCHING:
-        return switching(d, f_en, k_p, reach, d_t, c_max)
-    return improved_switching(d, f_en, k_p, reach, d_t, c_max)
+        return _switching(d, f_en, k_p, reach, d_t, c_max)
+    return _improved_switching(d, f_en, k_p, reach, d_t, c_max)
 
 
 def evaluate(function: str, d, f_en=0, *, k_p: float, reach: float, d_t: float, c_max: float) -> np.ndarray:

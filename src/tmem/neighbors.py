@@ -1,17 +1,22 @@
 """Which pairs of agents interact: neighbour lists over the corrected positions P* (6).
 
-Agents interact when ``|P*_j - P*_i| < R + R_j``.  Each agent keeps a list
-of candidates, sorted by index, in compressed rows (``ptr``, ``idx``):
+Agents interact when ``|P*_j - P*_i| < R + R_j``.  Candidates are kept in
+compressed rows (``ptr``, ``idx``), sorted by index:
 
-* **all pairs** — every other agent; built once (small swarms);
-* **Verlet lists** — every agent within ``R + R_j + skin``, found through a
+* **all pairs** — every pair; built once (small swarms);
+* **Verlet lists** — every pair within ``R + R_j + skin``, found through a
   cell grid of that side in O(N) and rebuilt only once some agent's P* has
   moved more than ``skin / 2`` since the last build.  No pair that is not
   listed can come within ``R + R_j`` before then.
 
-Because both kinds of list are sorted, an agent sums its neighbours'
-contributions in the same order either way: the two give the same bits.
-With a periodic box, differences are taken to the nearest image.
+The step loop takes each candidate pair once, as a list of ``(i, j)`` with
+``i < j`` sorted by ``i`` then ``j``, and gives the pair's pushes, equal and
+opposite, to both agents.  Every agent thus gets its neighbours'
+contributions in the order of their indices with either kind of list: the
+two give the same bits.  The loop numbers the
+agents in a spatial order (:func:`spatial_order`), so that neighbours are
+close in memory.  With a periodic box, differences are taken to the nearest
+image.
 """
 
 from __future__ import annotations
@@ -20,18 +25,16 @@ import numba
 import numpy as np
 
 
-def all_pairs(n_agents: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rows listing, for every agent, every other agent: ``(ptr, idx, order)`` with ``order`` the identity."""
-    idx = np.empty(n_agents * (n_agents - 1), dtype=np.int32)
-    for i in range(n_agents):
-        idx[i * (n_agents - 1) : (i + 1) * (n_agents - 1)] = np.delete(np.arange(n_agents), i)
-    ptr = np.arange(0, n_agents * (n_agents - 1) + 1, n_agents - 1, dtype=np.int64)
-    return ptr, idx, np.arange(n_agents, dtype=np.int64)
+def all_pairs(n_agents: int) -> np.ndarray:
+    """Every pair ``(i, j)``, ``i < j``, once, sorted: shape (pairs, 2), unsigned."""
+    return np.stack(np.triu_indices(n_agents, k=1), axis=1).astype(np.uint32)
 
 
 @numba.njit(cache=True)
 def nearest_image(delta, side):
     """``delta`` taken to the nearest periodic image along an axis of length ``side`` (0: not periodic)."""
+    if abs(delta) < 0.25 * side:
+        return delta  # what the rounding below gives, without a division
     if side > 0.0:
         return delta - side * np.floor(delta / side + 0.5)
     return delta
@@ -100,75 +103,169 @@ def _cells(points, active, cutoff, box):
     return cell_of, shape, start, order
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True)
+def _forward_rows(shape):
+    """Offsets of the rows of cells (along all axes but the last) that visit every pair of
+    neighbouring rows once: the row itself, then the offsets in {-1, 0, 1}^(axes - 1) whose first
+    non-zero entry is +1 (only 0 along an axis of one cell)."""
+    axes = shape.shape[0] - 1
+    rows = np.zeros((3**axes, axes), dtype=np.int64)
+    n = 1  # row 0: the row itself
+    for code in range(3**axes):
+        first = 0
+        valid = True
+        rest = code
+        for a in range(axes - 1, -1, -1):
+            o = rest % 3 - 1
+            rest //= 3
+            rows[n, a] = o
+            if o != 0 and shape[a] == 1:
+                valid = False
+            if o != 0:
+                first = o  # the last one set is the first axis's
+        if valid and first == 1:
+            n += 1
+    return rows[:n]
+
+
+@numba.njit(cache=True)
 def verlet_lists(points, active, cutoff, box, ptr, idx, order):
     """Verlet lists over *slots*: the active agents sorted by cell.
 
     Fills ``order[:m]`` with the agents in cell order (``m`` active agents) and,
     for each slot ``s``, row ``ptr[s]:ptr[s + 1]`` of ``idx`` with the slots of
     the agents within ``cutoff`` of agent ``order[s]``, sorted by agent index.
-    Neighbours in one cell grid are then close in memory.  Returns ``(needed,
-    m)``; if ``needed`` exceeds ``len(idx)`` the rows are not filled and the
-    caller must grow ``idx`` and call again.
+    Each pair of neighbouring cells is searched once; the cells along the last
+    axis are contiguous in slots, so a row of them is searched in one run.
+    Returns ``(needed, m)``; if ``needed`` exceeds ``len(idx)`` the rows are
+    not filled and the caller must grow ``idx`` and call again.
     """
     n, axes = points.shape
     cell_of, shape, start, cells_order = _cells(points, active, cutoff, box)
     m = cells_order.shape[0]
     order[:m] = cells_order
+    local = np.empty((m, axes))  # the points in slot order: neighbours close in memory
+    for s in range(m):
+        local[s] = points[cells_order[s]]
+    rows = _forward_rows(shape)
+    last = axes - 1
+    width = shape[last]
     cutoff2 = cutoff * cutoff
-    s1 = shape[1] if axes > 1 else 1
-    s2 = shape[2] if axes > 2 else 1
-    count = np.zeros(m, dtype=np.int64)
-    for fill in range(2):
-        if fill == 1:
-            ptr[0] = 0
-            for s in range(m):
-                ptr[s + 1] = ptr[s] + count[s]
-            if ptr[m] > idx.shape[0]:
-                return ptr[m], m
-        for s in numba.prange(m):
-            i = cells_order[s]
-            c = cell_of[i]
-            h0 = c // (s1 * s2)
-            h1 = (c // s2) % s1
-            h2 = c % s2
-            found = 0
-            for o0 in range(-1, 2) if shape[0] > 1 else range(0, 1):
-                k0 = h0 + o0
-                if box[0] > 0.0:
-                    k0 %= shape[0]
-                elif k0 < 0 or k0 >= shape[0]:
-                    continue
-                for o1 in range(-1, 2) if s1 > 1 else range(0, 1):
-                    k1 = h1 + o1
-                    if axes > 1 and box[1] > 0.0:
-                        k1 %= s1
-                    elif k1 < 0 or k1 >= s1:
-                        continue
-                    for o2 in range(-1, 2) if s2 > 1 else range(0, 1):
-                        k2 = h2 + o2
-                        if axes > 2 and box[2] > 0.0:
-                            k2 %= s2
-                        elif k2 < 0 or k2 >= s2:
-                            continue
-                        cell = (k0 * s1 + k1) * s2 + k2
-                        for t in range(start[cell], start[cell + 1]):
-                            j = cells_order[t]
-                            if j == i:
-                                continue
-                            r2 = 0.0
-                            for a in range(axes):
-                                delta = nearest_image(points[j, a] - points[i, a], box[a])
-                                r2 += delta * delta
-                            if r2 < cutoff2:
-                                if fill == 1:
-                                    # insertion into the row, kept sorted by agent index
-                                    q = ptr[s] + found
-                                    while q > ptr[s] and cells_order[idx[q - 1]] > j:
-                                        idx[q] = idx[q - 1]
-                                        q -= 1
-                                    idx[q] = t
-                                found += 1
-            if fill == 0:
-                count[s] = found
+    capacity = idx.shape[0] // 2
+    first = np.empty(capacity + 1, dtype=np.int32)  # the pairs found, by slot (one spare entry)
+    second = np.empty(capacity + 1, dtype=np.int32)
+    count = np.zeros(m + 1, dtype=np.int64)
+    n_pairs = 0
+    home = np.zeros(axes, dtype=np.int64)  # the cell's indices along the axes, counted up as c goes
+    home[last] = -1
+    runs = np.empty((2, 2), dtype=np.int64)  # up to two runs of cells along the last axis
+    for c in range(start.shape[0] - 1):
+        a = last
+        home[a] += 1
+        while home[a] == shape[a]:
+            home[a] = 0
+            a -= 1
+            home[a] += 1
+        if start[c] == start[c + 1]:
+            continue
+        for r in range(rows.shape[0]):
+            base = 0  # the neighbouring row's first cell
+            for a in range(last):
+                k = home[a] + rows[r, a]
+                if k < 0 or k >= shape[a]:
+                    if box[a] == 0.0:
+                        base = -1
+                        break
+                    k += shape[a] if k < 0 else -shape[a]  # round the periodic axis
+                base = base * shape[a] + k
+            if base < 0:
+                continue
+            base *= width
+            # cells home - 1 .. home + 1 along the last axis (from home itself in the same row)
+            low = home[last] if r == 0 else home[last] - 1
+            high = home[last] + 1
+            if width == 1:
+                low, high = 0, 0
+            n_runs = 1
+            runs[0, 0], runs[0, 1] = low, high
+            if box[last] == 0.0:
+                runs[0, 0], runs[0, 1] = max(low, 0), min(high, width - 1)
+            elif low < 0:
+                runs[0, 0], runs[1, 0], runs[1, 1] = 0, width - 1, width - 1
+                n_runs = 2
+            elif high == width:
+                runs[0, 1], runs[1, 0], runs[1, 1] = width - 1, 0, 0
+                n_runs = 2
+            for s in range(start[c], start[c + 1]):
+                found = 0
+                for q in range(n_runs):
+                    t_first = start[base + runs[q, 0]]
+                    if r == 0 and runs[q, 0] == home[last]:
+                        t_first = s + 1  # in its own cell, each pair once
+                    for t in range(t_first, start[base + runs[q, 1] + 1]):
+                        r2 = 0.0
+                        for a in range(axes):
+                            delta = nearest_image(local[t, a] - local[s, a], box[a])
+                            r2 += delta * delta
+                        close = r2 < cutoff2
+                        slot = min(n_pairs, capacity)  # past capacity, only counted
+                        first[slot] = s
+                        second[slot] = t
+                        n_pairs += close
+                        found += close
+                        count[t + 1] += close
+                count[s + 1] += found
+    ptr[: m + 1] = np.cumsum(count)
+    if ptr[m] > idx.shape[0]:
+        return ptr[m], m
+    fill = ptr[:m].copy()
+    for p in range(n_pairs):
+        s = first[p]
+        t = second[p]
+        idx[fill[s]] = t
+        fill[s] += 1
+        idx[fill[t]] = s
+        fill[t] += 1
+    for s in range(m):  # each row sorted by agent index, by insertion
+        for e in range(ptr[s] + 1, ptr[s + 1]):
+            t = idx[e]
+            q = e
+            while q > ptr[s] and cells_order[idx[q - 1]] > cells_order[t]:
+                idx[q] = idx[q - 1]
+                q -= 1
+            idx[q] = t
     return ptr[m], m
+
+
+@numba.njit(cache=True)
+def pair_list(ptr, idx, order, m, pairs):
+    """The pairs of Verlet lists (:func:`verlet_lists`), each once, in the points' own numbering.
+
+    Fills the rows of ``pairs`` (at least ``ptr[m] // 2``) with ``(i, j)``,
+    ``i < j``, sorted by ``i`` then ``j``, and returns how many there are.
+    """
+    start = np.zeros(order.shape[0] + 1, dtype=np.int64)
+    above = np.empty(m, dtype=np.int64)  # where each row's neighbours j > i begin: the row is sorted
+    for s in range(m):
+        i = order[s]
+        e = ptr[s]
+        while e < ptr[s + 1] and order[idx[e]] < i:
+            e += 1
+        above[s] = e
+        start[i + 1] = ptr[s + 1] - e
+    for i in range(order.shape[0]):
+        start[i + 1] += start[i]
+    for s in range(m):
+        i = order[s]
+        q = start[i]
+        for e in range(above[s], ptr[s + 1]):
+            pairs[q, 0] = i
+            pairs[q, 1] = order[idx[e]]
+            q += 1
+    return start[-1]
+
+
+def spatial_order(points: np.ndarray, active: np.ndarray, side: float, box: np.ndarray) -> np.ndarray:
+    """A numbering of the agents in which neighbours are close: active agents by cells of ``side``, then the rest."""
+    cells_order = _cells(points, active, side, box)[3]
+    return np.concatenate([cells_order, np.flatnonzero(~active)]).astype(np.int64)
