@@ -180,7 +180,7 @@ def test_a_killed_worker_loses_no_case(tmp_path):
 
 def test_ctrl_c_on_the_command_then_the_same_command_finishes(tmp_path):
     sweep_file = tmp_path / "encounters.toml"
-    sweep_file.write_text(ENCOUNTERS.format(cases=200, batch=4).replace("0.001", "0.0002"))
+    sweep_file.write_text(ENCOUNTERS.format(cases=1000, batch=8).replace("0.001", "0.0001"))  # a few seconds
     out = tmp_path / "out"
     command = [sys.executable, "-m", "tmem", "sweep", str(sweep_file), "--out", str(out), "--workers", "2"]
     # Ctrl-C in a terminal reaches the whole process group: the command and its workers.
@@ -196,7 +196,7 @@ def test_ctrl_c_on_the_command_then_the_same_command_finishes(tmp_path):
     finished = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert finished.returncode == 0, finished.stderr
     table = pd.read_parquet(out / "results.parquet")
-    assert list(table["case"]) == list(range(400))
+    assert list(table["case"]) == list(range(2000))
 
 
 def test_statistics_against_closed_forms():

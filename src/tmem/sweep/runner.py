@@ -20,6 +20,7 @@ case that raises.
 from __future__ import annotations
 
 import logging
+import math
 import os
 import signal
 import threading
@@ -40,6 +41,8 @@ from .tasks import plan_chunks, run_chunk
 #: Rows are written to disk at least this often (s) while tasks finish, and whenever this many wait.
 FLUSH_SECONDS = 2.0
 FLUSH_ROWS = 2000
+#: How often (s) the collecting loop looks for finished tasks and for Ctrl-C.
+POLL_SECONDS = 0.05
 
 
 class SweepInterrupted(Exception):
@@ -106,6 +109,26 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
         cluster.close()
 
 
+@contextmanager
+def _ctrl_c_as_flag() -> Iterator[threading.Event]:
+    """While the sweep runs, Ctrl-C sets a flag that the collecting loop reads between tasks.
+
+    A KeyboardInterrupt raised at a random point inside Dask's client machinery
+    leaves it half-stopped and logging tracebacks; read as a flag, Ctrl-C stops
+    the sweep in order.  (Only the main thread can take signals; elsewhere the
+    flag is never set.)
+    """
+    flag = threading.Event()
+    if threading.current_thread() is not threading.main_thread():
+        yield flag
+        return
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: flag.set())
+    try:
+        yield flag
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _failed_rows(chunk: list[Case], metrics: tuple[str, ...], exc: BaseException) -> list[dict]:
     message = f"{exc.__class__.__name__}: {' '.join(str(exc).split())}"
     rows = []
@@ -150,28 +173,35 @@ def run_sweep(
     if todo:
         waiting: list[dict] = []
         lost = ""
-        last_flush = time.perf_counter()
-        with dask_client(scheduler, workers) as client:
+        last_flush = -math.inf  # the first rows go to disk at once
+        with _ctrl_c_as_flag() as ctrl_c, dask_client(scheduler, workers) as client:
             from dask.distributed import as_completed
 
             base = client.scatter(sweep.base, broadcast=True)
             chunks = plan_chunks(sweep.base, todo, metrics, sweep.spec.batch)
             futures = {client.submit(run_chunk, base, chunk, metrics, pure=False): chunk for chunk in chunks}
+            finished = as_completed(futures)
             try:
-                for future in as_completed(futures):
-                    chunk = futures.pop(future)
-                    try:
-                        waiting += future.result()
-                        ran += len(chunk)
-                    except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
-                        lost = f"{exc.__class__.__name__} from the cluster ({' '.join(str(exc).split())})"
-                    except Exception as exc:  # e.g. a worker killed again and again by this chunk
-                        waiting += _failed_rows(chunk, metrics, exc)
-                        ran += len(chunk)
+                while not finished.is_empty():
+                    if ctrl_c.is_set():
+                        raise KeyboardInterrupt
+                    ready = finished.next_batch(block=False)
+                    if not ready:
+                        time.sleep(POLL_SECONDS)
+                    for future in ready:
+                        chunk = futures.pop(future)
+                        try:
+                            waiting += future.result()
+                            ran += len(chunk)
+                        except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
+                            lost = f"{exc.__class__.__name__} from the cluster ({' '.join(str(exc).split())})"
+                        except Exception as exc:  # e.g. a worker killed again and again by this chunk
+                            waiting += _failed_rows(chunk, metrics, exc)
+                            ran += len(chunk)
                     if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS:
                         store.add(waiting)
                         waiting, last_flush = [], time.perf_counter()
-                    if progress:
+                    if progress and ready:
                         progress(done + ran, sweep.n_cases)
                 store.add(waiting)
             except KeyboardInterrupt:
