@@ -140,7 +140,7 @@ beyond R + R_j = 40 m so that every pair starts uncoupled; each flies towards th
 axis the only direction that makes an encounter is towards each other; the sampled speeds set the
 pair's common velocity as well as its closing speed.
 
-Reproduce (about 1.5 minutes on this project's 2-core machine, see the benchmark below):
+Reproduce (43 s on this project's 2-core machine, median of 3 runs of `python benchmarks/bench_sweep.py`):
 
     tmem sweep examples/sweeps/encounters.toml --out out/encounters
     python docs/scripts/encounters.py out/encounters
