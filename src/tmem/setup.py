@@ -66,8 +66,9 @@ def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
     """Agents uniform in the region, numbered in cell order.
 
     The agents are numbered cell by cell over a grid of side ``R + R_j``
-    (last axis slowest), so that neighbours have nearby numbers and sit close
-    in memory: 1.4 times the throughput at N = 1e5.  Only the labels change.
+    (last axis slowest), so that neighbours have nearby numbers: recorded
+    subsets (``record_agents``) then pick out patches, not scattered agents.
+    The step loop orders agents in space by itself, whatever their numbers.
     """
     swarm = scenario.swarm
     rng = np.random.default_rng(swarm.seed)
