@@ -1,6 +1,5 @@
 """Bad input: one line naming the field and the reason, exit status 2, no traceback, no output."""
 
-import os
 import subprocess
 import sys
 from pathlib import Path

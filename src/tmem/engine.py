@@ -218,7 +218,6 @@ def _advance_source(
     u = np.zeros((n_agents, n_axes))
     d = np.empty(n_axes)
     v = np.empty(n_axes)
-    reach2 = reach * reach
     for k in range(k_start, k_stop):
         # 1. operator commands
         rebuild = False

@@ -34,9 +34,9 @@ from pathlib import Path
 import pandas as pd
 
 from .report import write_report
-from .spec import Case, Sweep, SweepError
+from .spec import Sweep, SweepError
 from .store import ResultStore
-from .tasks import plan_chunks, run_chunk
+from .tasks import one_line, plan_chunks, row, run_chunk
 
 #: Rows are written to disk at least this often (s) while tasks finish, and whenever this many wait.
 FLUSH_SECONDS = 2.0
@@ -69,6 +69,11 @@ class SweepOutcome:
     seconds: float
 
 
+def _takes_signals() -> bool:
+    """Only the main thread can install signal handlers."""
+    return threading.current_thread() is threading.main_thread()
+
+
 @contextmanager
 def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
     """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes."""
@@ -78,7 +83,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
         try:
             client = Client(scheduler, timeout="20s")
         except (OSError, TimeoutError, ValueError) as exc:
-            raise SweepError(f"--scheduler {scheduler}: cannot connect ({' '.join(str(exc).split())})") from None
+            raise SweepError(f"--scheduler {scheduler}: cannot connect ({one_line(exc)})") from None
         try:
             yield client
         finally:
@@ -87,7 +92,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
     # Ctrl-C reaches every process of the terminal's group.  The worker processes are started with
     # SIGINT ignored (they inherit it), so that only this process answers it: it saves the rows it
     # has and shuts the cluster down, instead of every worker dying with a traceback.
-    main_thread = threading.current_thread() is threading.main_thread()  # where signals can be handled
+    main_thread = _takes_signals()
     interrupt = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
     try:
         cluster = LocalCluster(
@@ -119,7 +124,7 @@ def _ctrl_c_as_flag() -> Iterator[threading.Event]:
     flag is never set.)
     """
     flag = threading.Event()
-    if threading.current_thread() is not threading.main_thread():
+    if not _takes_signals():
         yield flag
         return
     previous = signal.signal(signal.SIGINT, lambda signum, frame: flag.set())
@@ -127,14 +132,6 @@ def _ctrl_c_as_flag() -> Iterator[threading.Event]:
         yield flag
     finally:
         signal.signal(signal.SIGINT, previous)
-
-
-def _failed_rows(chunk: list[Case], metrics: tuple[str, ...], exc: BaseException) -> list[dict]:
-    message = f"{exc.__class__.__name__}: {' '.join(str(exc).split())}"
-    rows = []
-    for case in chunk:
-        rows.append({"case": case.index, **case.changes, **dict.fromkeys(metrics), "error": message, "seconds": None})
-    return rows
 
 
 def run_sweep(
@@ -194,9 +191,9 @@ def run_sweep(
                             waiting += future.result()
                             ran += len(chunk)
                         except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
-                            lost = f"{exc.__class__.__name__} from the cluster ({' '.join(str(exc).split())})"
+                            lost = f"{one_line(exc)} (from the cluster)"
                         except Exception as exc:  # e.g. a worker killed again and again by this chunk
-                            waiting += _failed_rows(chunk, metrics, exc)
+                            waiting += [row(case, metrics, None, one_line(exc), None) for case in chunk]
                             ran += len(chunk)
                     if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS:
                         store.add(waiting)

@@ -79,7 +79,13 @@ def _value(summary: dict, metric: str) -> Any:
     return node
 
 
-def _row(case: Case, metrics: tuple[str, ...], values: dict | None, error: str | None, seconds: float) -> dict:
+def one_line(exc: BaseException) -> str:
+    """An exception as one line: its class and its message with whitespace folded."""
+    message = " ".join(str(exc).split())
+    return f"{exc.__class__.__name__}: {message}" if message else exc.__class__.__name__
+
+
+def row(case: Case, metrics: tuple[str, ...], values: dict | None, error: str | None, seconds: float) -> dict:
     row = {"case": case.index, **case.changes}
     row.update({m: None if values is None else values[m] for m in metrics})
     row["error"] = error
@@ -92,9 +98,8 @@ def _run_one(base: Scenario, case: Case, metrics: tuple[str, ...]) -> dict:
     try:
         summary = summarize(simulate(with_changes(base, case.changes)))
     except Exception as exc:  # a failing case is a row with its error, never the end of the sweep
-        message = " ".join(str(exc).split()) or exc.__class__.__name__
-        return _row(case, metrics, None, f"{exc.__class__.__name__}: {message}", time.perf_counter() - started)
-    return _row(case, metrics, {m: _value(summary, m) for m in metrics}, None, time.perf_counter() - started)
+        return row(case, metrics, None, one_line(exc), time.perf_counter() - started)
+    return row(case, metrics, {m: _value(summary, m) for m in metrics}, None, time.perf_counter() - started)
 
 
 def _run_as_batch(scenario: Scenario, cases: list[Case], starts: np.ndarray, metrics: tuple[str, ...]) -> list[dict]:
@@ -107,7 +112,7 @@ def _run_as_batch(scenario: Scenario, cases: list[Case], starts: np.ndarray, met
     for c, case in enumerate(cases):
         values = {m: _python(columns[m][c]) for m in metrics}
         diverged = not np.all(np.isfinite(result.final_velocities[c])) or not np.isfinite(result.final_distance[c])
-        rows.append(_row(case, metrics, None if diverged else values, DIVERGED if diverged else None, seconds))
+        rows.append(row(case, metrics, None if diverged else values, DIVERGED if diverged else None, seconds))
     return rows
 
 
