@@ -27,13 +27,17 @@ vehicle); an added agent starts from its ``[[agents]]`` entry.  The loop is
 compiled with Numba and runs in chunks, so that a caller can show progress
 between them.  It keeps the agents in *slots*, numbered in a spatial order
 so that neighbours are close in memory, and takes each neighbouring pair
-once (:mod:`tmem.neighbors`); the per-agent steps use threads in large
-swarms.
+once, in an order that does not depend on the kind of list or the number of
+threads (:mod:`tmem.neighbors`).  In large swarms the per-agent steps and the
+neighbour sums of separate blocks of agents run on threads.  The neighbour
+sums go in chunks of pairs: gathered, pushed in vectorised arithmetic, then
+added to both agents.
 """
 
 from __future__ import annotations
 
 import time as _time
+import types
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -43,7 +47,7 @@ import numpy as np
 from . import coupling, interaction
 from .control import modal_gains
 from .model import state_matrices, zero_order_hold
-from .neighbors import all_pairs, nearest_image, pair_list, spatial_order, verlet_lists
+from .neighbors import all_pairs, arrange, nearest_image, spatial_order, verlet_pairs
 from .scenario import Scenario
 from .setup import Setup, build
 
@@ -52,6 +56,9 @@ UNCOUPLE, COUPLE, REMOVE, ADD = range(4)
 _COMMAND_CODES = {"uncouple": UNCOUPLE, "couple": COUPLE, "remove": REMOVE, "add": ADD}
 #: Swarms at least this large use Verlet lists and threads ("auto").
 LARGE_SWARM = 64
+#: Agents per block of the neighbour sums (:func:`tmem.neighbors.arrange`); it fixes the order of
+#: each agent's sum, so results do not depend on the number of threads.
+BLOCK = 4096
 #: Status returned by the compiled loop when the neighbour lists must be built before step k.
 _LISTS_STALE = -1
 
@@ -142,71 +149,68 @@ class Trajectory:
         return self.setup.d_t
 
 
-@numba.njit(cache=True)
-def _is_partner(adj_ptr, adj_idx, i, j):
-    """Whether agents ``i`` and ``j`` are a formation pair (rows ``adj_ptr``, ``adj_idx`` of partners)."""
-    for e in range(adj_ptr[i], adj_ptr[i + 1]):
-        if adj_idx[e] == j:
-            return True
-    return False
+#: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
+CHUNK = 256
 
 
-@numba.njit(cache=True, error_model="numpy")
-def _neighbour_pushes(p_star, x, active, pairs, n_pairs, adj_ptr, adj_idx, box, function, k_p, reach, c_max, u, closest):
-    """Step 3: set ``u`` to the summed pushes of every agent's non-formation neighbours.
-
-    Each listed pair ``(i, j)``, ``i < j`` (the first ``n_pairs`` rows of
-    ``pairs``, sorted), is taken once, and its pushes, equal and opposite, go
-    to both agents: in this order every agent gets its neighbours' pushes by
-    increasing index, whatever the lists.  ``closest[0]`` keeps the smallest
-    squared distance ``|P_j - P_i|^2`` of a pair within reach.
-    """
-    n_axes = len(box)  # a tuple: compiled for each number of axes
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _chunk_pushes(diff, m, n_axes, function, k_p, reach, c_max):
+    """The pushes of ``m`` pairs, in place: ``diff[a]`` holds ``d_a = P*_j - P*_i`` on entry and the
+    push on agent ``i`` along axis ``a``, ``f(|d|) d_a / |d|``, on return (0 beyond ``reach``).
+    ``diff[n_axes + a]`` holds ``P_j - P_i``; ``diff[2 n_axes]`` gets ``|P_j - P_i|^2`` for the
+    pairs within reach, ``inf`` for the others.  No branches: the compiler vectorises it."""
     reach2 = reach * reach
-    u[:] = 0.0
-    nearest2 = closest[0]
-    for e in range(n_pairs):  # one loop over all pairs: no branch per agent
-        i = pairs[e, 0]
-        j = pairs[e, 1]
-        if not (active[i] and active[j]):
-            continue
-        d0 = nearest_image(p_star[j, 0] - p_star[i, 0], box[0])
-        r2 = d0 * d0
-        d1 = 0.0
-        d2 = 0.0
-        if n_axes > 1:
-            d1 = nearest_image(p_star[j, 1] - p_star[i, 1], box[1])
-            r2 += d1 * d1
-        if n_axes > 2:
-            d2 = nearest_image(p_star[j, 2] - p_star[i, 2], box[2])
-            r2 += d2 * d2
-        if r2 >= reach2 or r2 == 0.0:
-            continue
-        if adj_ptr[i] < adj_ptr[i + 1] and _is_partner(adj_ptr, adj_idx, i, j):
-            continue
-        dist2 = 0.0
+    for t in range(m):
+        r2 = 0.0
         for a in range(n_axes):
-            delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
-            dist2 += delta * delta
-        nearest2 = min(nearest2, dist2)
+            r2 += diff[a, t] * diff[a, t]
+        inside = (r2 < reach2) & (r2 > 0.0)
         r = np.sqrt(r2)
         push = interaction.pair_control(function, r, 0, k_p, reach, 0.0, c_max) / r
-        u[i, 0] += push * d0
-        u[j, 0] -= push * d0
-        if n_axes > 1:
-            u[i, 1] += push * d1
-            u[j, 1] -= push * d1
-        if n_axes > 2:
-            u[i, 2] += push * d2
-            u[j, 2] -= push * d2
-    closest[0] = nearest2
+        push = push if inside else 0.0
+        dist2 = 0.0
+        for a in range(n_axes):
+            dist2 += diff[n_axes + a, t] * diff[n_axes + a, t]
+            diff[a, t] *= push
+        diff[2 * n_axes, t] = dist2 if inside else np.inf
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _neighbour_pushes(pos, pairs, first, stop, box, function, k_p, reach, c_max, u):
+    """Add to ``u`` the pushes of pairs ``first:stop`` of ``pairs``, each ``(i, j)`` once, equal and
+    opposite, in the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.
+
+    ``pos[i, a]`` holds ``(P*, P)`` of agent ``i`` on axis ``a``.  Step 3 of the loop: the
+    non-formation neighbours' pushes, ``f(|d|)`` along ``d / |d|``, with ``f`` the repulsion (8) or
+    the scenario's flagless function."""
+    n_axes = len(box)  # a tuple: compiled for each number of axes
+    diff = np.empty((2 * n_axes + 1, CHUNK))
+    nearest2 = np.inf
+    for begin in range(first, stop, CHUNK):
+        m = min(CHUNK, stop - begin)
+        for t in range(m):
+            i = pairs[begin + t, 0]
+            j = pairs[begin + t, 1]
+            for a in range(n_axes):
+                diff[a, t] = nearest_image(pos[j, a, 0] - pos[i, a, 0], box[a])
+                diff[n_axes + a, t] = nearest_image(pos[j, a, 1] - pos[i, a, 1], box[a])
+        _chunk_pushes(diff, m, n_axes, function, k_p, reach, c_max)
+        for t in range(m):
+            nearest2 = min(nearest2, diff[2 * n_axes, t])
+        for t in range(m):
+            i = pairs[begin + t, 0]
+            j = pairs[begin + t, 1]
+            for a in range(n_axes):
+                u[i, a] += diff[a, t]
+                u[j, a] -= diff[a, t]
+    return nearest2
 
 
 def _advance_source(
     k_start, k_stop, n_steps, record_every,
     x, active, x_start, ad, bd, gains, function, couples, at_crossing, pair_function, k_p, reach, eps, c_max, box,
-    use_lists, skin, pairs, n_pairs, p_ref,
-    edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, adj_ptr, adj_idx, edge_min, closest,
+    use_lists, skin, pairs, n_inside, n_pairs, block_ptr, p_ref,
+    edge_i, edge_j, edge_dt, edge_dir, flag, armed, r_before, edge_min, closest,
     cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
     rec_slots, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
     event_step, event_kind, event_i, event_j, event_action, n_events,
@@ -214,8 +218,10 @@ def _advance_source(
     n_agents = x.shape[0]
     n_axes = len(box)  # a tuple: the loop is compiled for each number of axes
     n_edges = edge_i.shape[0]
-    p_star = np.empty((n_agents, n_axes))
+    n_blocks = block_ptr.shape[0] - 1
+    pos = np.empty((n_agents, n_axes, 2))  # (P*, P) of each agent on each axis
     u = np.zeros((n_agents, n_axes))
+    block_nearest2 = np.empty(n_blocks)
     d = np.empty(n_axes)
     v = np.empty(n_axes)
     for k in range(k_start, k_stop):
@@ -227,9 +233,9 @@ def _advance_source(
             if kind == REMOVE or kind == ADD:
                 i = cmd_target[cmd_ptr[c]]
                 active[i] = kind == ADD
+                rebuild = True  # the pairs listed are those of flying agents
                 if kind == ADD:
                     x[i] = x_start[i]
-                    rebuild = True
                 else:
                     for a in range(n_axes):
                         x[i, a, 1:] = 0.0  # a lost vehicle: it stops where it is
@@ -256,19 +262,24 @@ def _advance_source(
                 s = 0.0
                 for m in range(4):
                     s += x[i, a, m] * gains[m]
-                p_star[i, a] = s / gains[0]
+                pos[i, a, 0] = s / gains[0]
+                pos[i, a, 1] = x[i, a, 0]
                 if use_lists:
-                    delta = nearest_image(p_star[i, a] - p_ref[i, a], box[a])
+                    delta = nearest_image(pos[i, a, 0] - p_ref[i, a], box[a])
                     shift2 += delta * delta
             moved = max(moved, shift2 if active[i] else 0.0)
-        if use_lists and (rebuild or np.sqrt(moved) > 0.5 * skin):
-            # The caller builds the lists from p_ref = P* now, and resumes at step k.
-            p_ref[:] = p_star
+        if rebuild or (use_lists and np.sqrt(moved) > 0.5 * skin):
+            # The caller lists the pairs again, from p_ref = P* now, and resumes at step k.
+            p_ref[:] = pos[:, :, 0]
             return k, next_command, next_record, n_events, _LISTS_STALE
-        # 3. non-formation neighbours
-        _neighbour_pushes(
-            p_star, x, active, pairs, n_pairs, adj_ptr, adj_idx, box, pair_function, k_p, reach, c_max, u, closest
-        )  # fmt: skip
+        # 3. non-formation neighbours: each block's own pairs on its thread, then the crossing pairs
+        u[:] = 0.0
+        for b in numba.prange(n_blocks):
+            block_nearest2[b] = _neighbour_pushes(
+                pos, pairs, block_ptr[b], block_ptr[b + 1], box, pair_function, k_p, reach, c_max, u
+            )  # fmt: skip
+        nearest2 = _neighbour_pushes(pos, pairs, n_inside, n_pairs, box, pair_function, k_p, reach, c_max, u)
+        closest[0] = min(closest[0], nearest2, block_nearest2.min())
         # 4. formation pairs
         for e in range(n_edges):
             i = edge_i[e]
@@ -287,9 +298,9 @@ def _advance_source(
             r2 = 0.0
             dist2 = 0.0
             for a in range(n_axes):
-                d[a] = nearest_image(p_star[j, a] - p_star[i, a], box[a])
+                d[a] = nearest_image(pos[j, a, 0] - pos[i, a, 0], box[a])
                 r2 += d[a] * d[a]
-                delta = nearest_image(x[j, a, 0] - x[i, a, 0], box[a])
+                delta = nearest_image(pos[j, a, 1] - pos[i, a, 1], box[a])
                 dist2 += delta * delta
             r = np.sqrt(r2)
             dist = np.sqrt(dist2)
@@ -345,7 +356,7 @@ def _advance_source(
                 for a in range(n_axes):
                     delta = nearest_image(x[edge_j[e], a, 0] - x[edge_i[e], a, 0], box[a])
                     dist2 += delta * delta
-                    delta = nearest_image(p_star[edge_j[e], a] - p_star[edge_i[e], a], box[a])
+                    delta = nearest_image(pos[edge_j[e], a, 0] - pos[edge_i[e], a, 0], box[a])
                     r2 += delta * delta
                 rec_dist[next_record, e] = np.sqrt(dist2)
                 rec_dstar[next_record, e] = np.sqrt(r2)
@@ -367,8 +378,19 @@ def _advance_source(
     return k_stop, next_command, next_record, n_events, 0
 
 
-_advance_serial = numba.njit(cache=True, error_model="numpy")(_advance_source)
-_advance_threaded = numba.njit(cache=True, parallel=True, error_model="numpy")(_advance_source)
+def _named(function, name):
+    """The same code under another name.  Numba keys its on-disk cache by the function's name, not by
+    ``parallel``: compiled from one function, the serial and threaded loops would share a cache, and
+    whichever was compiled first would stand in for both."""
+    twin = types.FunctionType(function.__code__, function.__globals__, name)
+    twin.__qualname__ = name
+    return twin
+
+
+_advance_serial = numba.njit(cache=True, error_model="numpy")(_named(_advance_source, "_advance_serial"))
+_advance_threaded = numba.njit(cache=True, parallel=True, error_model="numpy")(
+    _named(_advance_source, "_advance_threaded")
+)
 
 
 def record_steps(n_steps: int, record_every: int) -> np.ndarray:
@@ -448,14 +470,11 @@ def simulate(
 
     method = scenario.neighbors.method
     use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
-    if use_lists:
-        pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)  # unsigned: no negative-index check in the loop
-        full_ptr = np.zeros(n_agents + 1, dtype=np.int64)
-        full_idx = np.empty(16 * n_agents, dtype=np.int32)
-        cells = np.empty(n_agents, dtype=np.int64)
-    else:
-        pairs = all_pairs(n_agents)
-    n_pairs = len(pairs)
+    # Pairs are unsigned: no negative-index check in the loop.
+    pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)
+    found = np.empty((2, len(pairs) + 64), dtype=np.int32)
+    block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
+    n_inside = n_pairs = 0
     advance = _advance_threaded if n_agents >= LARGE_SWARM else _advance_serial
 
     cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt, slot)
@@ -483,21 +502,27 @@ def simulate(
     p_ref = np.zeros((n_agents, n_axes))
     builds = 0
 
-    def build_lists() -> None:
-        """Build the neighbour lists from ``p_ref`` (each pair once), growing the arrays if needed."""
-        nonlocal builds, full_idx, pairs, n_pairs
-        cutoff = ia.reach + scenario.neighbors.skin
-        needed, slots = verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
-        if needed > len(full_idx):
-            full_idx = np.empty(int(1.5 * needed) + 16, dtype=np.int32)
-            pairs = np.empty((len(full_idx) // 2, 2), dtype=np.uint32)
-            verlet_lists(p_ref, active, cutoff, setup.box, full_ptr, full_idx, cells)
-        n_pairs = pair_list(full_ptr, full_idx, cells, slots, pairs)
-        builds += 1
+    def list_pairs() -> None:
+        """List the pairs of flying agents (within reach and skin of each other in ``p_ref``, with
+        Verlet lists), each once, in the loop's order (:func:`arrange`); grow the arrays if needed."""
+        nonlocal builds, pairs, found, n_inside, n_pairs
+        if use_lists:
+            cutoff = ia.reach + scenario.neighbors.skin
+            parts = numba.get_num_threads()
+            listed, room = verlet_pairs(p_ref, active, cutoff, box, pairs, found, parts)
+            if listed > len(pairs) or room > found.shape[1]:
+                pairs = np.empty((int(1.5 * max(listed, len(pairs))) + 16, 2), dtype=np.uint32)
+                found = np.empty((2, int(1.5 * max(room, found.shape[1])) + 16), dtype=np.int32)
+                verlet_pairs(p_ref, active, cutoff, box, pairs, found, parts)
+            builds += 1
+        else:
+            pairs = all_pairs(active)
+            listed = len(pairs)
+        n_inside, n_pairs = arrange(pairs, listed, adj_ptr, adj_idx, BLOCK, block_ptr)
 
-    if use_lists:
-        p_ref[:] = x @ (gains / gains[0])  # P* (6) at the start
-        build_lists()
+    box = tuple(setup.box.tolist())
+    p_ref[:] = x @ (gains / gains[0])  # P* (6) at the start
+    list_pairs()
 
     next_command = next_record = n_events = 0
     k = 0
@@ -510,15 +535,15 @@ def simulate(
             x, active, x_start, ad, bd, gains,
             interaction.FUNCTIONS.index(ia.function), interaction.uses_coupling(ia.function), ia.switch_at == "crossing",
             interaction.REPULSION if interaction.uses_coupling(ia.function) else interaction.FUNCTIONS.index(ia.function),
-            gains[0], ia.reach, ia.eps, ia.c_max, tuple(setup.box.tolist()),
-            use_lists, scenario.neighbors.skin, pairs, n_pairs, p_ref,
-            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, adj_ptr, adj_idx, edge_min, closest,
+            gains[0], ia.reach, ia.eps, ia.c_max, box,
+            use_lists, scenario.neighbors.skin, pairs, n_inside, n_pairs, block_ptr, p_ref,
+            edge_i, edge_j, setup.d_t, setup.direction, flag, armed, r_before, edge_min, closest,
             cmd_step, cmd_kind, cmd_ptr, cmd_target, next_command,
             rec_slots, rec_state, rec_control, rec_active, rec_flag, rec_dist, rec_dstar, next_record,
             event_step, event_kind, event_i, event_j, event_action, n_events,
         )  # fmt: skip
-        if status == _LISTS_STALE:  # build the neighbour lists and go on from the same step
-            build_lists()
+        if status == _LISTS_STALE:  # list the pairs again and go on from the same step
+            list_pairs()
             continue
         elapsed = _time.perf_counter() - started
         if progress is not None:

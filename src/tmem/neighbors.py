@@ -1,22 +1,28 @@
 """Which pairs of agents interact: neighbour lists over the corrected positions P* (6).
 
-Agents interact when ``|P*_j - P*_i| < R + R_j``.  Candidates are kept in
-compressed rows (``ptr``, ``idx``), sorted by index:
+Agents interact when ``|P*_j - P*_i| < R + R_j``.  The step loop takes a list
+of candidate pairs ``(i, j)``, ``i < j``, of flying agents:
 
-* **all pairs** — every pair; built once (small swarms);
-* **Verlet lists** — every pair within ``R + R_j + skin``, found through a
-  cell grid of that side in O(N) and rebuilt only once some agent's P* has
-  moved more than ``skin / 2`` since the last build.  No pair that is not
-  listed can come within ``R + R_j`` before then.
+* **all pairs** (:func:`all_pairs`) — every pair; for small swarms;
+* **Verlet lists** (:func:`verlet_pairs`) — every pair within
+  ``R + R_j + skin``, found through a cell grid of that side in O(N) and
+  rebuilt only once some agent's P* has moved more than ``skin / 2`` since the
+  last build.  No pair that is not listed can come within ``R + R_j`` before
+  then.
 
-The step loop takes each candidate pair once, as a list of ``(i, j)`` with
-``i < j`` sorted by ``i`` then ``j``, and gives the pair's pushes, equal and
-opposite, to both agents.  Every agent thus gets its neighbours'
-contributions in the order of their indices with either kind of list: the
-two give the same bits.  The loop numbers the
-agents in a spatial order (:func:`spatial_order`), so that neighbours are
-close in memory.  With a periodic box, differences are taken to the nearest
-image.
+Both lists come sorted by ``i`` then ``j``, and :func:`arrange` puts them in
+the loop's order: it drops formation pairs, and cuts the agents into blocks of
+consecutive indices, the pairs inside each block first and the pairs crossing
+between blocks after.  The loop sums the blocks on separate threads, then the
+crossing pairs, giving each pair's pushes, equal and opposite, to both agents.
+Every agent thus adds its neighbours' pushes in one fixed order: those from
+its own block by increasing index, then those from other blocks by
+increasing index.  The order depends on the agents' indices and the block
+size only, not on the kind of list or the number of threads, so all of these
+give the same bits.  The loop numbers the agents in a spatial order
+(:func:`spatial_order`), so that neighbours are close in memory and few
+pairs cross between blocks.  With a periodic box, differences are taken to
+the nearest image.
 """
 
 from __future__ import annotations
@@ -25,12 +31,14 @@ import numba
 import numpy as np
 
 
-def all_pairs(n_agents: int) -> np.ndarray:
-    """Every pair ``(i, j)``, ``i < j``, once, sorted: shape (pairs, 2), unsigned."""
-    return np.stack(np.triu_indices(n_agents, k=1), axis=1).astype(np.uint32)
+def all_pairs(active: np.ndarray) -> np.ndarray:
+    """Every pair ``(i, j)``, ``i < j``, of active agents, once, sorted: shape (pairs, 2), unsigned."""
+    flying = np.flatnonzero(active)
+    first, second = np.triu_indices(len(flying), k=1)
+    return np.stack([flying[first], flying[second]], axis=1).astype(np.uint32)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def nearest_image(delta, side):
     """``delta`` taken to the nearest periodic image along an axis of length ``side`` (0: not periodic)."""
     if abs(delta) < 0.25 * side:
@@ -129,37 +137,29 @@ def _forward_rows(shape):
 
 
 @numba.njit(cache=True)
-def verlet_lists(points, active, cutoff, box, ptr, idx, order):
-    """Verlet lists over *slots*: the active agents sorted by cell.
+def _search(local, start, shape, box, cutoff, c_first, c_stop, found, offset, room):
+    """The pairs of points within ``cutoff``, one of them in cells ``c_first:c_stop``.
 
-    Fills ``order[:m]`` with the agents in cell order (``m`` active agents) and,
-    for each slot ``s``, row ``ptr[s]:ptr[s + 1]`` of ``idx`` with the slots of
-    the agents within ``cutoff`` of agent ``order[s]``, sorted by agent index.
-    Each pair of neighbouring cells is searched once; the cells along the last
-    axis are contiguous in slots, so a row of them is searched in one run.
-    Returns ``(needed, m)``; if ``needed`` exceeds ``len(idx)`` the rows are
-    not filled and the caller must grow ``idx`` and call again.
+    Each pair of neighbouring cells is searched once, from the first in cell
+    order; the cells along the last axis are contiguous in slots, so a row of
+    them is searched in one run.  The pairs of slots found go to
+    ``found[:, offset:offset + room]``; returns how many there are (past
+    ``room - 1``, only counted).
     """
-    n, axes = points.shape
-    cell_of, shape, start, cells_order = _cells(points, active, cutoff, box)
-    m = cells_order.shape[0]
-    order[:m] = cells_order
-    local = np.empty((m, axes))  # the points in slot order: neighbours close in memory
-    for s in range(m):
-        local[s] = points[cells_order[s]]
+    axes = len(box)  # a tuple: compiled for each number of axes
     rows = _forward_rows(shape)
     last = axes - 1
     width = shape[last]
     cutoff2 = cutoff * cutoff
-    capacity = idx.shape[0] // 2
-    first = np.empty(capacity + 1, dtype=np.int32)  # the pairs found, by slot (one spare entry)
-    second = np.empty(capacity + 1, dtype=np.int32)
-    count = np.zeros(m + 1, dtype=np.int64)
-    n_pairs = 0
+    n_found = 0
     home = np.zeros(axes, dtype=np.int64)  # the cell's indices along the axes, counted up as c goes
-    home[last] = -1
+    rest = c_first
+    for a in range(last, -1, -1):
+        home[a] = rest % shape[a]
+        rest //= shape[a]
+    home[last] -= 1  # the loop counts up before each cell
     runs = np.empty((2, 2), dtype=np.int64)  # up to two runs of cells along the last axis
-    for c in range(start.shape[0] - 1):
+    for c in range(c_first, c_stop):
         a = last
         home[a] += 1
         while home[a] == shape[a]:
@@ -197,7 +197,6 @@ def verlet_lists(points, active, cutoff, box, ptr, idx, order):
                 runs[0, 1], runs[1, 0], runs[1, 1] = width - 1, 0, 0
                 n_runs = 2
             for s in range(start[c], start[c + 1]):
-                found = 0
                 for q in range(n_runs):
                     t_first = start[base + runs[q, 0]]
                     if r == 0 and runs[q, 0] == home[last]:
@@ -207,62 +206,118 @@ def verlet_lists(points, active, cutoff, box, ptr, idx, order):
                         for a in range(axes):
                             delta = nearest_image(local[t, a] - local[s, a], box[a])
                             r2 += delta * delta
-                        close = r2 < cutoff2
-                        slot = min(n_pairs, capacity)  # past capacity, only counted
-                        first[slot] = s
-                        second[slot] = t
-                        n_pairs += close
-                        found += close
-                        count[t + 1] += close
-                count[s + 1] += found
-    ptr[: m + 1] = np.cumsum(count)
-    if ptr[m] > idx.shape[0]:
-        return ptr[m], m
-    fill = ptr[:m].copy()
-    for p in range(n_pairs):
-        s = first[p]
-        t = second[p]
-        idx[fill[s]] = t
-        fill[s] += 1
-        idx[fill[t]] = s
-        fill[t] += 1
-    for s in range(m):  # each row sorted by agent index, by insertion
-        for e in range(ptr[s] + 1, ptr[s + 1]):
-            t = idx[e]
+                        slot = offset + min(n_found, room - 1)  # written always, kept if close: no branch
+                        found[0, slot] = s
+                        found[1, slot] = t
+                        n_found += r2 < cutoff2
+    return n_found
+
+
+@numba.njit(cache=True, parallel=True)
+def verlet_pairs(points, active, cutoff, box, pairs, found, parts):
+    """Every pair of active points within ``cutoff`` of each other: a Verlet list, each pair once.
+
+    Fills the rows of ``pairs`` with ``(i, j)``, ``i < j``, sorted by ``i`` then
+    ``j``, and returns ``(count, room)``: how many pairs there are, and the room
+    ``found`` needs.  ``box`` is a tuple (one entry per axis).  The points are
+    binned into cells of side ``>= cutoff`` (:func:`_cells`), cut into
+    ``parts`` with about as many points each (one per thread), and the parts
+    searched side by side (:func:`_search`), each into its share of ``found``
+    (shape (2, room), int32).  If ``pairs`` or a share of ``found`` is too
+    small, nothing is filled; the caller must grow them and call again.
+    """
+    n = points.shape[0]
+    axes = len(box)  # a tuple: compiled for each number of axes
+    cell_of, shape, start, cells_order = _cells(points, active, cutoff, np.array(box))
+    m = cells_order.shape[0]
+    local = np.empty((m, axes))  # the points in cell order: neighbours close in memory
+    for s in numba.prange(m):
+        local[s] = points[cells_order[s]]
+    share = found.shape[1] // parts
+    if share == 0:  # room to count in, at least
+        found = np.empty((2, parts), dtype=np.int32)
+        share = 1
+    bounds = np.searchsorted(start, np.arange(parts + 1) * m // parts)  # first cell of each part
+    bounds[parts] = start.shape[0] - 1
+    counts = np.empty(parts, dtype=np.int64)
+    for p in numba.prange(parts):
+        counts[p] = _search(local, start, shape, box, cutoff, bounds[p], bounds[p + 1], found, p * share, share)
+    n_found = counts.sum()
+    room = parts * (counts.max() + 1)
+    if n_found > pairs.shape[0] or room > found.shape[1]:
+        return n_found, room
+    # Counting sort by the first point, then each point's run by the second, by insertion.
+    end = np.zeros(n + 1, dtype=np.int64)
+    for p in range(parts):
+        for q in range(p * share, p * share + counts[p]):
+            end[min(cells_order[found[0, q]], cells_order[found[1, q]]) + 1] += 1
+    for i in range(n):
+        end[i + 1] += end[i]
+    for p in range(parts):
+        for q in range(p * share, p * share + counts[p]):
+            i = cells_order[found[0, q]]
+            j = cells_order[found[1, q]]
+            if i > j:
+                i, j = j, i
+            pairs[end[i], 0] = i
+            pairs[end[i], 1] = j
+            end[i] += 1
+    begin = 0
+    for i in range(n):  # end[i] is now where i's run ends
+        for e in range(begin + 1, end[i]):
+            j = pairs[e, 1]
             q = e
-            while q > ptr[s] and cells_order[idx[q - 1]] > cells_order[t]:
-                idx[q] = idx[q - 1]
+            while q > begin and pairs[q - 1, 1] > j:
+                pairs[q, 1] = pairs[q - 1, 1]
                 q -= 1
-            idx[q] = t
-    return ptr[m], m
+            pairs[q, 1] = j
+        begin = end[i]
+    return n_found, room
 
 
 @numba.njit(cache=True)
-def pair_list(ptr, idx, order, m, pairs):
-    """The pairs of Verlet lists (:func:`verlet_lists`), each once, in the points' own numbering.
+def is_partner(adj_ptr, adj_idx, i, j):
+    """Whether agents ``i`` and ``j`` are a formation pair (rows ``adj_ptr``, ``adj_idx`` of partners)."""
+    for e in range(adj_ptr[i], adj_ptr[i + 1]):
+        if adj_idx[e] == j:
+            return True
+    return False
 
-    Fills the rows of ``pairs`` (at least ``ptr[m] // 2``) with ``(i, j)``,
-    ``i < j``, sorted by ``i`` then ``j``, and returns how many there are.
+
+@numba.njit(cache=True)
+def arrange(pairs, n_pairs, adj_ptr, adj_idx, block, block_ptr):
+    """Put sorted pairs in the order the step loop takes them; returns ``(n_inside, n_kept)``.
+
+    Formation pairs (partners in rows ``adj_ptr``, ``adj_idx``) are dropped:
+    they interact through their own function.  The agents are cut into blocks
+    of ``block`` consecutive indices.  Pairs within one block come first, in
+    their sorted order, and ``block_ptr[b]`` is where block ``b``'s begin; the
+    pairs that cross from one block to another follow, also sorted.  Blocks
+    can then be summed on separate threads without two writing to the same
+    agent, and the crossing pairs after them on one.
     """
-    start = np.zeros(order.shape[0] + 1, dtype=np.int64)
-    above = np.empty(m, dtype=np.int64)  # where each row's neighbours j > i begin: the row is sorted
-    for s in range(m):
-        i = order[s]
-        e = ptr[s]
-        while e < ptr[s + 1] and order[idx[e]] < i:
-            e += 1
-        above[s] = e
-        start[i + 1] = ptr[s + 1] - e
-    for i in range(order.shape[0]):
-        start[i + 1] += start[i]
-    for s in range(m):
-        i = order[s]
-        q = start[i]
-        for e in range(above[s], ptr[s + 1]):
-            pairs[q, 0] = i
-            pairs[q, 1] = order[idx[e]]
-            q += 1
-    return start[-1]
+    crossing = np.empty((n_pairs, 2), dtype=pairs.dtype)
+    n_inside = 0
+    n_crossing = 0
+    block_ptr[:] = 0
+    for e in range(n_pairs):
+        i = pairs[e, 0]
+        j = pairs[e, 1]
+        if adj_ptr[i] < adj_ptr[i + 1] and is_partner(adj_ptr, adj_idx, i, j):
+            continue
+        if i // block == j // block:
+            pairs[n_inside, 0] = i
+            pairs[n_inside, 1] = j
+            n_inside += 1
+            block_ptr[i // block + 1] += 1
+        else:
+            crossing[n_crossing, 0] = i
+            crossing[n_crossing, 1] = j
+            n_crossing += 1
+    for b in range(block_ptr.shape[0] - 1):
+        block_ptr[b + 1] += block_ptr[b]
+    pairs[n_inside : n_inside + n_crossing] = crossing[:n_crossing]
+    return n_inside, n_inside + n_crossing
 
 
 def spatial_order(points: np.ndarray, active: np.ndarray, side: float, box: np.ndarray) -> np.ndarray:
