@@ -68,9 +68,10 @@ def test_verlet_lists_give_the_same_bits_as_all_pairs(axes, periodic):
 
 def test_threaded_loop_gives_the_same_bits_as_the_serial_one(monkeypatch):
     monkeypatch.setattr(engine, "BLOCK", 32)  # several blocks, summed on both threads
+    monkeypatch.setattr(engine, "THREADED_SWARM", 100)
     scenario = random_swarm(200, 2, True, "verlet")
     threaded = tmem.simulate(scenario)
-    monkeypatch.setattr(engine, "LARGE_SWARM", 10**9)
+    monkeypatch.setattr(engine, "THREADED_SWARM", 10**9)
     serial = tmem.simulate(scenario)
     assert threaded.final_state.tobytes() == serial.final_state.tobytes()
 
