@@ -70,8 +70,14 @@ def _rss_bytes() -> int:
 def run_case(n: int, steps: int, repeat: int, skin: float) -> dict:
     """Time ``repeat`` runs of gas-N in this process (call in a fresh child for the memory figure)."""
     import tmem
+    from tmem import engine
 
-    tmem.simulate(gas(min(n, 2000), steps=5, skin=skin), record=False)  # compile / load the loop
+    # Compile or load both step loops on a small swarm: the serial one and, by lowering the threshold
+    # for this one run, the threaded one that large N use.
+    tmem.simulate(gas(min(n, 2000), steps=5, skin=skin), record=False)
+    threshold, engine.THREADED_SWARM = engine.THREADED_SWARM, 0
+    tmem.simulate(gas(min(n, 2000), steps=5, skin=skin), record=False)
+    engine.THREADED_SWARM = threshold
     baseline = _rss_bytes()
     scenario = gas(n, steps, skin)
     times, builds = [], 0
