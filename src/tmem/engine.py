@@ -475,11 +475,11 @@ def simulate(
 
     method = scenario.neighbors.method
     use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
-    # Pairs are unsigned: no negative-index check in the loop.
-    pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)
-    found = np.empty((2, len(pairs) + 64), dtype=np.int32)
+    box = tuple(setup.box.tolist())
+    if use_lists:  # pairs are unsigned, as all_pairs gives them: no negative-index check in the loop
+        pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)
+        found = np.empty((2, len(pairs) + 64), dtype=np.int32)
     block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
-    n_inside = n_pairs = 0
     advance = _advance_threaded if n_agents >= THREADED_SWARM else _advance_serial
 
     cmd_step, cmd_kind, cmd_ptr, cmd_target = _commands(scenario, edges, sim.dt, slot)
@@ -507,10 +507,11 @@ def simulate(
     p_ref = np.zeros((n_agents, n_axes))
     builds = 0
 
-    def list_pairs() -> None:
+    def list_pairs() -> tuple[int, int]:
         """List the pairs of flying agents (within reach and skin of each other in ``p_ref``, with
-        Verlet lists), each once, in the loop's order (:func:`arrange`); grow the arrays if needed."""
-        nonlocal builds, pairs, found, n_inside, n_pairs
+        Verlet lists), each once, in the loop's order; grow the arrays if needed.  Returns
+        ``(n_inside, n_pairs)`` of :func:`arrange`."""
+        nonlocal builds, pairs, found
         if use_lists:
             cutoff = ia.reach + scenario.neighbors.skin
             parts = numba.get_num_threads()
@@ -523,11 +524,10 @@ def simulate(
         else:
             pairs = all_pairs(active)
             listed = len(pairs)
-        n_inside, n_pairs = arrange(pairs, listed, adj_ptr, adj_idx, BLOCK, block_ptr)
+        return arrange(pairs, listed, adj_ptr, adj_idx, BLOCK, block_ptr)
 
-    box = tuple(setup.box.tolist())
     p_ref[:] = x @ (gains / gains[0])  # P* (6) at the start
-    list_pairs()
+    n_inside, n_pairs = list_pairs()
 
     next_command = next_record = n_events = 0
     k = 0
@@ -548,7 +548,7 @@ def simulate(
             event_step, event_kind, event_i, event_j, event_action, n_events,
         )  # fmt: skip
         if status == _LISTS_STALE:  # list the pairs again and go on from the same step
-            list_pairs()
+            n_inside, n_pairs = list_pairs()
             continue
         elapsed = _time.perf_counter() - started
         if progress is not None:
