@@ -70,7 +70,7 @@ def _rss_bytes() -> int:
 def run_case(n: int, steps: int, repeat: int, skin: float) -> dict:
     """Time ``repeat`` runs of gas-N in this process (call in a fresh child for the memory figure)."""
     import tmem
-    from tmem import engine
+    from tmem.engine import driver as engine
 
     # Compile or load both step loops on a small swarm: the serial one and, by lowering the threshold
     # for this one run, the threaded one that large N use.

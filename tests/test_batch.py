@@ -11,7 +11,7 @@ from tmem.scenario import with_changes
 STARTS = [((50.0, 0.0), (-1.5, 3.0)), ((60.0, 0.0), (-2.0, 2.0)), ((0.0, 45.0), (4.0, -4.0)), ((100.0, 0.0), (-0.5, 1.0))]
 
 
-@pytest.mark.parametrize("function", tmem.FUNCTIONS)
+@pytest.mark.parametrize("function", tmem.FUNCTION_NAMES)
 @pytest.mark.parametrize("switch_at", ["window", "crossing"])
 def test_batch_equals_the_engine(function, switch_at):
     base = with_changes(

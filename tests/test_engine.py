@@ -6,7 +6,7 @@ from scipy.linalg import expm
 
 import tmem
 from tmem.engine import record_steps
-from tmem.model import state_matrices
+from tmem.model.linear import state_matrices
 from tmem.scenario import with_changes
 
 
@@ -14,7 +14,7 @@ def short(preset="fig9", **changes):
     return with_changes(tmem.preset(preset), {"simulation.duration": 40.0, **changes})
 
 
-@pytest.mark.parametrize("function", tmem.FUNCTIONS)
+@pytest.mark.parametrize("function", tmem.FUNCTION_NAMES)
 def test_two_agents_keep_their_total_momentum(function):
     """Pair forces are equal and opposite and the model is linear, so V0 + V1 never changes."""
     tr = tmem.simulate(short(**{"interaction.function": function}))
@@ -23,7 +23,7 @@ def test_two_agents_keep_their_total_momentum(function):
     np.testing.assert_allclose(total, total[0], rtol=0, atol=1e-10)
 
 
-@pytest.mark.parametrize("function", tmem.FUNCTIONS)
+@pytest.mark.parametrize("function", tmem.FUNCTION_NAMES)
 def test_mirror_image_gives_mirror_trajectory(function):
     s = short(**{"interaction.function": function})
     mirrored = with_changes(s, {"agents": [{"position": -a.position, "velocity": -a.velocity} for a in s.agents]})

@@ -54,64 +54,97 @@ def test_odd_in_d_and_saturated(function, f_en):
     assert np.all(np.abs(u) <= C_MAX)
 
 
+def f(function, d, f_en=0, c_max=C_MAX):
+    return interaction.evaluate(function, d, f_en, k_p=K_P, reach=REACH, d_t=D_T, c_max=c_max)
+
+
 def test_repulsion_pushes_apart_inside_and_is_zero_outside():
-    u = interaction.repulsion(np.array([10.0, 39.0, 40.0, 41.0]), K_P, REACH, C_MAX)
+    u = f("repulsion", np.array([10.0, 39.0, 40.0, 41.0]))
     assert u[0] == -C_MAX  # saturated
     assert u[1] == pytest.approx(-K_P * 1.0)  # linear part K_P c
     assert u[2] == 0.0 and u[3] == 0.0  # |d| = R + R_j is outside
 
 
 def test_attraction_pulls_beyond_d_t_and_pushes_inside():
-    u = interaction.attraction(np.array([30.0, 35.0, 36.0, 39.0, 40.0]), K_P, REACH, D_T, C_MAX)
+    u = f("attraction", np.array([30.0, 35.0, 36.0, 39.0, 40.0]))
     assert u[0] < 0 and u[1] == 0.0 and u[2] > 0 and u[3] == C_MAX and u[4] == 0.0
 
 
 def test_improved_f1_is_continuous_at_b_and_d_t():
-    f1 = lambda d: interaction.improved_switching(d, 0, K_P, REACH, D_T, C_MAX)  # noqa: E731
     for point in (B, D_T):
         for h in (1e-6, 1e-9):
-            assert abs(f1(point - h) - f1(point + h)) < 2 * K_P * h + 1e-15
-    assert f1(B) == pytest.approx(-K_P * (REACH - B))  # the repulsive peak of the tent
-    assert f1(D_T) == 0.0
+            assert abs(f("improved", point - h) - f("improved", point + h)) < 2 * K_P * h + 1e-15
+    assert f("improved", B) == pytest.approx(-K_P * (REACH - B))  # the repulsive peak of the tent
+    assert f("improved", D_T) == 0.0
 
 
 def test_improved_f1_equals_f2_inside_d_t():
     d = np.linspace(-D_T, D_T, 1001)
-    f1 = interaction.improved_switching(d, 0, K_P, REACH, D_T, C_MAX)
-    f2 = interaction.improved_switching(d, 1, K_P, REACH, D_T, C_MAX)
-    np.testing.assert_array_equal(f1, f2)
+    np.testing.assert_array_equal(f("improved", d, 0), f("improved", d, 1))
 
 
 def test_improved_f1_and_f2_differ_between_d_t_and_reach():
     d = np.linspace(D_T + 0.1, REACH - 0.1, 50)
-    f1 = interaction.improved_switching(d, 0, K_P, REACH, D_T, C_MAX)
-    f2 = interaction.improved_switching(d, 1, K_P, REACH, D_T, C_MAX)
-    assert np.all(f1 < 0) and np.all(f2 > 0)
+    assert np.all(f("improved", d, 0) < 0) and np.all(f("improved", d, 1) > 0)
 
 
 def test_switching_steps_at_the_coupling_point():
     """(10): at |d| = d_t, f1 is the repulsion, f2 is zero: a jump of min(K_P (reach - d_t), c_max)."""
-    f1 = interaction.switching(D_T, 0, K_P, REACH, D_T, C_MAX)
-    f2 = interaction.switching(D_T, 1, K_P, REACH, D_T, C_MAX)
+    f1, f2 = f("switching", D_T, 0), f("switching", D_T, 1)
     assert f2 == 0.0
     assert f1 - f2 == pytest.approx(-min(K_P * (REACH - D_T), C_MAX))
     # Unsaturated, the step is the full K_P (reach - d_t).
-    f1_wide = interaction.switching(D_T, 0, K_P, REACH, D_T, 1.0)
-    assert f1_wide == pytest.approx(-K_P * (REACH - D_T))
+    assert f("switching", D_T, 0, c_max=1.0) == pytest.approx(-K_P * (REACH - D_T))
 
 
 def test_coupled_attraction_has_no_range_limit():
-    assert interaction.switching(100.0, 1, K_P, REACH, D_T, C_MAX) == C_MAX
-    assert interaction.improved_switching(-100.0, 1, K_P, REACH, D_T, C_MAX) == -C_MAX
-
-
-def test_dispatch_matches_named_functions():
-    for code, name in enumerate(interaction.FUNCTIONS):
-        for d in BREAKPOINTS:
-            for f_en in (0, 1):
-                expected = interaction.evaluate(name, d, f_en, **PARAMS)
-                assert interaction.pair_control(code, d, f_en, K_P, REACH, D_T, C_MAX) == expected
+    assert f("switching", 100.0, 1) == C_MAX
+    assert f("improved", -100.0, 1) == -C_MAX
 
 
 def test_uses_coupling():
-    assert [interaction.uses_coupling(f) for f in interaction.FUNCTIONS] == [False, False, True, True]
+    assert [interaction.uses_coupling(name) for name in interaction.FUNCTION_NAMES] == [False, False, True, True]
+
+
+# Every registered function, checked for what the method needs of any interaction function and for
+# what its registry row claims.
+ROWS = [pytest.param(row, id=row.name) for row in interaction.FUNCTIONS]
+FINE = np.linspace(-2 * REACH, 2 * REACH, 160_001)
+
+
+@pytest.mark.parametrize("row", ROWS)
+def test_every_function_is_saturated_odd_and_repels_when_close(row):
+    for f_en in (0, 1) if row.couples else (0,):
+        u = f(row.name, FINE, f_en)
+        assert np.all(np.abs(u) <= C_MAX)
+        np.testing.assert_array_equal(u, -f(row.name, -FINE, f_en))
+    close = np.linspace(0.01, 5.0, 50)
+    assert np.all(f(row.name, close, 0) < 0)  # pushes apart (U < 0 for d > 0) when nearly touching
+
+
+@pytest.mark.parametrize("row", ROWS)
+def test_every_function_leaves_uncoupled_agents_beyond_reach_alone(row):
+    assert np.all(f(row.name, np.linspace(REACH, 10 * REACH, 100), 0) == 0.0)
+
+
+@pytest.mark.parametrize("row", ROWS)
+def test_continuity_is_as_the_registry_claims(row):
+    """Continuous rows move by no more than the slope K_P allows between neighbouring points of a fine
+    grid of ``|d|``; the others jump somewhere by more than that."""
+    r = np.linspace(1e-3, 2 * REACH, 80_001)
+    largest_step = np.abs(np.diff(f(row.name, r, 0))).max()
+    slope_bound = K_P * (r[1] - r[0]) * (1 + 1e-9)
+    assert (largest_step <= slope_bound) == row.continuous, largest_step
+
+
+@pytest.mark.parametrize("row", ROWS)
+def test_each_row_names_a_kernel_and_its_code_dispatches_to_it(row):
+    from tmem.interaction import kernels
+
+    code = interaction.code(row.name)
+    params = kernels.FunctionParams(K_P, REACH, D_T, C_MAX)
+    for r in BREAKPOINTS[1:]:  # d > 0: evaluate takes the signed measure
+        for f_en in (0, 1):
+            expected = getattr(kernels, row.kernel).py_func(r, f_en, params)
+            assert kernels.pair_control.py_func(code, r, f_en, params) == expected
+            assert f(row.name, r, f_en) == expected

@@ -6,7 +6,8 @@ import pytest
 import tmem
 from tmem.engine import Event, Trajectory
 from tmem.metrics import nearest_distance, pair_summary, rms_velocity, summarize
-from tmem.setup import build
+from tmem.initial import build
+from tmem.model import vehicle_model
 
 
 def made(distance, flag, events, velocities=None):
@@ -19,7 +20,8 @@ def made(distance, flag, events, velocities=None):
         state[:, :, 0, 1] = velocities
     return Trajectory(
         scenario=scenario,
-        setup=build(scenario),
+        initial=build(scenario),
+        model=vehicle_model(scenario.model),
         gains=np.ones(4),
         time=np.arange(n, dtype=float),
         agents=np.array([0, 1]),

@@ -33,7 +33,7 @@ def run(function, start):
 
 @pytest.fixture(scope="module", params=STARTS, ids=[f"start{k}" for k in range(len(STARTS))])
 def results(request):
-    return {f: run(f, request.param) for f in tmem.FUNCTIONS}, request.param
+    return {f: run(f, request.param) for f in tmem.FUNCTION_NAMES}, request.param
 
 
 def test_attraction_alone_does_not_couple(results):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem import engine
+from tmem.engine import driver as engine
+from tmem.engine.driver import _partners
 from tmem.metrics import summarize
 from tmem.neighbors import arrange, verlet_pairs
 from tmem.scenario import from_dict, with_changes
@@ -117,7 +118,7 @@ def test_arrange_drops_formation_pairs_and_cuts_blocks():
     n, block = 10, 4
     pairs = np.array([(i, j) for i in range(n) for j in range(i + 1, n)], dtype=np.uint32)
     partners = np.array([[1, 2], [2, 9]])
-    adj_ptr, adj_idx = engine._partners(n, partners)
+    adj_ptr, adj_idx = _partners(n, partners)
     block_ptr = np.empty(n // block + 2, dtype=np.int64)
     inside, kept = arrange(pairs, len(pairs), adj_ptr, adj_idx, block, block_ptr)
     expected_inside = [(i, j) for i in range(n) for j in range(i + 1, n) if i // block == j // block]
@@ -134,8 +135,8 @@ def test_periodic_gas_keeps_momentum_and_stays_in_the_box():
     """Pushes across the box edge are equal and opposite too.  With several neighbours, saturating
     an agent's summed set-point breaks that symmetry, so c_max is set too high to saturate here."""
     tr = tmem.simulate(with_changes(random_swarm(300, 2, True, "auto"), {"interaction.c_max": 10.0}))
-    side = tr.setup.box[0]
-    p0 = tr.setup.state[:, :, 1].sum(axis=0)
+    side = tr.initial.box[0]
+    p0 = tr.initial.state[:, :, 1].sum(axis=0)
     np.testing.assert_allclose(tr.final_state[:, :, 1].sum(axis=0), p0, atol=1e-9)
     assert np.all((tr.final_state[:, :, 0] >= 0) & (tr.final_state[:, :, 0] < side))
 
@@ -263,3 +264,26 @@ def test_losing_an_agent_uncouples_its_pairs_as_events():
     tr = tmem.simulate(formation("ring", 6, commands=[{"time": 5.0, "action": "remove", "agent": 2}]))
     lost = sorted(e.agents for e in tr.events if e.kind == "uncouple")
     assert lost == [(1, 2), (2, 3)] and all(e.time == pytest.approx(5.0) for e in tr.events)
+
+
+@pytest.mark.parametrize("function", tmem.FUNCTION_NAMES)
+@pytest.mark.parametrize("n_agents", [2, 32, 34, 80])
+def test_a_pair_feels_its_function_whatever_the_size_of_the_swarm(function, n_agents):
+    """Two agents at rest 30 m apart (d_t = 35 m) and the others far away: the first set-point on agent 0
+    is the function's value at |d| = 30 m, whether the pair is tracked one by one (small swarms, coupling
+    functions) or summed among the neighbours (flagless functions beyond 32 agents, by all pairs or by
+    Verlet lists).  Unsaturated (c_max = 1 rad), attraction gives K_P (30 - 35) < 0; with d_t lost on
+    one path it gave K_P 30 > 0."""
+    agents = [{"position": 0.0}, {"position": 30.0}] + [{"position": 1000.0 + 100.0 * k} for k in range(n_agents - 2)]
+    scenario = from_dict({
+        "interaction": {"function": function, "c_max": 1.0, "d_t": 35.0},
+        "simulation": {"dt": 0.01, "duration": 0.1, "record_every": 1},
+        "agents": agents,
+    })  # fmt: skip
+    tr = tmem.simulate(scenario)
+    k_p = tr.gains[0]
+    expected = tmem.interaction.evaluate(function, 30.0, 0, k_p=k_p, reach=40.0, d_t=35.0, c_max=1.0)
+    assert tr.control[0, 0, 0] == pytest.approx(float(expected), rel=1e-12)
+    assert tr.control[0, 1, 0] == pytest.approx(-float(expected), rel=1e-12)
+    if function == "attraction":
+        assert expected == pytest.approx(k_p * (30.0 - 35.0))

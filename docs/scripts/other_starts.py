@@ -41,7 +41,7 @@ def main() -> None:
     print("| --- | --- | --- | --- | --- | --- | --- |")
     both, failing = [], []
     for v0, v1 in STARTS:
-        r = {f: run(f, v0, v1) for f in tmem.FUNCTIONS}
+        r = {f: run(f, v0, v1) for f in tmem.FUNCTION_NAMES}
         ratio = DASH
         if r["switching"]["coupled"] and r["improved"]["coupled"]:
             value = r["switching"]["rms_change_percent"] / r["improved"]["rms_change_percent"]

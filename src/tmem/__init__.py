@@ -14,34 +14,26 @@ The public API, in the order data flows::
 
 __version__ = "0.1.0"
 
-from . import _numba_cache  # noqa: E402
-
-_numba_cache.refresh()  # before any compiled function is loaded
-
 from .control import interaction_point, modal_gains, printed_gains, roots  # noqa: E402
 from .engine import Event, Trajectory, simulate  # noqa: E402
-from .interaction import FUNCTIONS, attraction, improved_switching, repulsion, switching  # noqa: E402
-from .model import state_matrices, zero_order_hold  # noqa: E402
+from .interaction import FUNCTION_NAMES  # noqa: E402
+from .model.linear import state_matrices, zero_order_hold  # noqa: E402
 from .scenario import Scenario, ScenarioError, load, loads, preset  # noqa: E402
 
 __all__ = [
-    "FUNCTIONS",
+    "FUNCTION_NAMES",
     "Event",
     "Scenario",
     "ScenarioError",
     "Trajectory",
-    "attraction",
-    "improved_switching",
     "interaction_point",
     "load",
     "loads",
     "modal_gains",
     "preset",
     "printed_gains",
-    "repulsion",
     "roots",
     "simulate",
     "state_matrices",
-    "switching",
     "zero_order_hold",
 ]

@@ -23,9 +23,12 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from . import coupling, interaction
-from .control import modal_gains
-from .model import state_matrices, zero_order_hold
+from . import coupling
+from .control import corrected_position, gains_for
+from .engine.driver import law_of
+from .interaction.kernels import pair_control
+from .model import vehicle_model
+from .model.linear import hold_step
 from .scenario import Scenario
 
 
@@ -52,14 +55,28 @@ class BatchResult:
 LANES = 8
 
 
+@numba.njit(cache=True, inline="always")
+def _free_flight_steps(d, velocity, steps_left, gap, dt):
+    """Steps a free pair (uncoupled, level, ``gap`` m beyond reach and window) may skip: every step
+    left if it separates (``d`` grows), else those before it could close the gap at ``velocity``."""
+    closing = -velocity if d > 0 else velocity
+    if closing <= 0.0:
+        return steps_left
+    return min(steps_left, int(gap / (closing * dt)) - 1)
+
+
 # fastmath "contract" only: the multiply-adds may fuse (one rounding instead of two); NaN and
 # infinity keep their meaning, which the flag logic relies on (r_before is NaN after a skip).
 @numba.njit(cache=True, parallel=True, error_model="numpy", fastmath={"contract"})
-def _run_batch(
-    e0, n_steps, dt, command_step, ad, bd, gains, function, couples, at_crossing, reach, d_t, eps, c_max,
-    e_end, min_dist, couple_step, uncouple_step,
-):  # fmt: skip
-    k_p = gains[0]
+def _run_batch(e0, n_steps, dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step):
+    """Advance each case of ``e0`` (cases, 4) ``n_steps`` steps of ``dt`` under ``law`` with the
+    functions' parameters ``params`` and the zero-order hold ``hold`` of the linear model; write each
+    case's end, smallest distance, and the steps it first coupled and uncoupled (-1: never).
+    (Records are used inside the parallel loop only as arguments: see :class:`tmem.engine.records.Law`.)"""
+    gains = law.gains
+    reach, d_t, eps, c_max = params.reach, params.d_t, law.eps, params.c_max
+    function, couples, at_crossing = law.function, law.couples, law.at_crossing
+    ad, bd = hold.ad, hold.bd
     n_cases = e0.shape[0]
     for block in numba.prange((n_cases + LANES - 1) // LANES):
         first = block * LANES
@@ -86,18 +103,14 @@ def _run_batch(
                 running += 1
                 if k[c] == command_step:
                     armed[c] = 0
-                d = (gains[0] * e_p[c] + gains[1] * e_v[c] + gains[2] * e_phi[c] + gains[3] * e_om[c]) / k_p
+                d = corrected_position(e_p[c], e_v[c], e_phi[c], e_om[c], gains)
                 r = abs(d)
                 lowest[c] = min(lowest[c], abs(e_p[c]))
                 # Free flight: uncoupled, out of reach, level (the tilt has died out).  Then
                 # d = P + (K_V / K_P) V moves at the constant rate V, so the flight is skipped in
                 # closed form: to the end if the pair separates, else to just before it meets.
                 if flag[c] == 0 and r > reach + eps and abs(e_phi[c]) < 1e-13 and abs(e_om[c]) < 1e-12 and k[c] < n_steps:
-                    closing = -e_v[c] if d > 0 else e_v[c]
-                    if closing <= 0.0:
-                        skip = n_steps - k[c]
-                    else:
-                        skip = min(n_steps - k[c], int((r - reach - eps) / (closing * dt)) - 1)
+                    skip = _free_flight_steps(d, e_v[c], n_steps - k[c], r - reach - eps, dt)
                     if skip > 1:
                         if k[c] < command_step <= k[c] + skip:
                             armed[c] = 0
@@ -116,15 +129,10 @@ def _run_batch(
                     r_before[c] = r
                 u0 = 0.0
                 if r > 0.0:
-                    u0 = interaction.pair_control(function, r, flag[c], k_p, reach, d_t, c_max) * (1.0 if d > 0 else -1.0)
+                    u0 = pair_control(function, r, flag[c], params) * (1.0 if d > 0 else -1.0)
                     u0 = min(max(u0, -c_max), c_max)
                 if k[c] < n_steps:
-                    u_rel = -2.0 * u0
-                    p, v, f, o = e_p[c], e_v[c], e_phi[c], e_om[c]
-                    e_p[c] = ad[0, 0] * p + ad[0, 1] * v + ad[0, 2] * f + ad[0, 3] * o + bd[0] * u_rel
-                    e_v[c] = ad[1, 0] * p + ad[1, 1] * v + ad[1, 2] * f + ad[1, 3] * o + bd[1] * u_rel
-                    e_phi[c] = ad[2, 0] * p + ad[2, 1] * v + ad[2, 2] * f + ad[2, 3] * o + bd[2] * u_rel
-                    e_om[c] = ad[3, 0] * p + ad[3, 1] * v + ad[3, 2] * f + ad[3, 3] * o + bd[3] * u_rel
+                    e_p[c], e_v[c], e_phi[c], e_om[c] = hold_step(ad, bd, e_p[c], e_v[c], e_phi[c], e_om[c], -2.0 * u0)
                 k[c] += 1
         for lane in range(lanes):
             e_end[first + lane] = (e_p[lane], e_v[lane], e_phi[lane], e_om[lane])
@@ -141,6 +149,8 @@ def unsupported(scenario: Scenario) -> str | None:
     agents' positions and velocities vary; their tilts and tilt rates start at
     zero.
     """
+    if scenario.model.kind != "linear":
+        return "needs the linear model (2): a batch steps the pair's relative state"
     if scenario.space.axes != 1 or len(scenario.agents) != 2 or scenario.formation is not None:
         return "needs a one-axis scenario with two agents listed in [[agents]], without a formation"
     if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
@@ -164,10 +174,10 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     reason = unsupported(scenario)
     if reason:
         raise ValueError(f"run_batch: {reason}")
-    m, c, ia, sim = scenario.model, scenario.controller, scenario.interaction, scenario.simulation
-    a, b = state_matrices(m.kp, m.kd, m.g)
-    ad, bd = zero_order_hold(a, b, sim.dt)
-    gains = modal_gains(m.kp, m.kd, m.g, c.r_l, c.im_l, c.im_r)
+    c, sim = scenario.controller, scenario.simulation
+    model = vehicle_model(scenario.model)
+    hold = model.step_params(sim.dt)
+    law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r))
     positions = np.asarray(positions, dtype=float)
     velocities = np.asarray(velocities, dtype=float)
     cases = len(positions)
@@ -177,17 +187,13 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     relative = start[:, 1] - start[:, 0]
     total = start[:, 1] + start[:, 0]
     n_steps = sim.n_steps
-    command_step = int(round(scenario.commands[0].time / sim.dt)) if scenario.commands else -1
+    command_step = sim.step_of(scenario.commands[0].time) if scenario.commands else -1
     e_end = np.empty((cases, 4))
     min_dist = np.empty(cases)
     couple_step = np.empty(cases, dtype=np.int64)
     uncouple_step = np.empty(cases, dtype=np.int64)
-    _run_batch(
-        relative, n_steps, sim.dt, command_step, ad, bd, gains, interaction.FUNCTIONS.index(ia.function),
-        interaction.uses_coupling(ia.function), ia.switch_at == "crossing", ia.reach, ia.d_t, ia.eps, ia.c_max,
-        e_end, min_dist, couple_step, uncouple_step,
-    )  # fmt: skip
-    total_end = total @ np.linalg.matrix_power(ad, n_steps).T  # the sum flies free
+    _run_batch(relative, n_steps, sim.dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step)
+    total_end = total @ np.linalg.matrix_power(hold.ad, n_steps).T  # the sum flies free
     v0 = (total_end[:, 1] - e_end[:, 1]) / 2
     v1 = (total_end[:, 1] + e_end[:, 1]) / 2
     rms0 = np.sqrt((velocities**2).mean(axis=1))

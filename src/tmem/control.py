@@ -18,7 +18,10 @@ polynomial of ``A - B K`` with that of the roots instead; the derivation is in
 
 from __future__ import annotations
 
+import numba
 import numpy as np
+
+from . import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 
 
 def roots(r_l: float, im_l: float, im_r: float) -> np.ndarray:
@@ -39,11 +42,22 @@ def modal_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r: f
     These follow from equating ``det(sI - A + B K)`` with
     ``(s^2 + 2 r_l s + r_l^2 + im_l^2)(s^2 + im_r^2)``.
 
+    Parameters
+    ----------
+    kp, kd, g
+        The model's parameters (1)-(2), Table 1.
+    r_l, im_l, im_r
+        The roots (5), Table 1.
+
     Returns
     -------
     ndarray, shape (4,)
     """
-    beta = 1.0 / (kp * kd)
+    return _paper_gains(kp * kd, kd, g, r_l, im_l, im_r)
+
+
+def _paper_gains(kp_kd: float, kd: float, g: float, r_l: float, im_l: float, im_r: float) -> np.ndarray:
+    beta = 1.0 / kp_kd
     left = r_l**2 + im_l**2
     return np.array(
         [
@@ -53,6 +67,36 @@ def modal_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r: f
             beta * (2.0 * r_l - kd),
         ]
     )
+
+
+def gains_for(a: np.ndarray, b: np.ndarray, r_l: float, im_l: float, im_r: float) -> np.ndarray:
+    """Modal gains placing the roots (5) for a vehicle model's linearisation ``(A, B)``.
+
+    Where ``(A, B)`` has the structure of the paper's model (2) (all the
+    linear model's, and a quadrotor's at hover), the closed form of
+    :func:`modal_gains` is used with ``g = A[1, 2]``, ``kd = -A[3, 3]`` and
+    ``kp kd = B[3]``; any other linearisation is handed to
+    :func:`scipy.signal.place_poles`.
+
+    Parameters
+    ----------
+    a : ndarray, shape (4, 4)
+    b : ndarray, shape (4,)
+        The linearisation on ``(P, V, phi, omega)`` with the tilt set-point as input.
+    r_l, im_l, im_r
+        The roots (5).
+
+    Returns
+    -------
+    ndarray, shape (4,)
+    """
+    g, kd, kp_kd = a[1, 2], -a[3, 3], b[3]
+    paper_form = np.array([[0, 1, 0, 0], [0, 0, g, 0], [0, 0, 0, 1], [0, 0, -kp_kd, -kd]], dtype=float)
+    if np.array_equal(a, paper_form) and np.array_equal(b, [0.0, 0.0, 0.0, kp_kd]):
+        return _paper_gains(kp_kd, kd, g, r_l, im_l, im_r)
+    from scipy.signal import place_poles
+
+    return place_poles(a, b[:, None], roots(r_l, im_l, im_r)).gain_matrix[0]
 
 
 def printed_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r: float) -> np.ndarray:
@@ -89,3 +133,13 @@ def interaction_point(x: np.ndarray, gains: np.ndarray) -> np.ndarray:
         ``K`` from :func:`modal_gains`; ``K_P = gains[0]`` is the paper's ``K1``.
     """
     return x @ (gains / gains[0])
+
+
+@numba.njit(cache=True, inline="always")
+def corrected_position(p, v, phi, omega, gains):
+    """``P* = x . K / K_P`` (6) of one axis's state ``x = (p, v, phi, omega)``, in compiled code.
+
+    The same quantity as :func:`interaction_point`, for the step loop and the batch; the sum runs
+    in the order of the state, so every caller gets the same bits.
+    """
+    return (p * gains[0] + v * gains[1] + phi * gains[2] + omega * gains[3]) / gains[0]

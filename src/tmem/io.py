@@ -22,16 +22,9 @@ import xarray as xr
 
 from . import __version__, metrics, plot
 from .engine import Trajectory
-from .model import STATE_NAMES
 
 PAPER = "E. Heiss, A. Kozyr, O. Morozov, Formations Organization in Robotic Swarm Using the Thermal Motion Equivalent Method"
 
-_STATE_ATTRS = {
-    "P": ("position", "m"),
-    "V": ("velocity", "m s-1"),
-    "phi": ("tilt from the vertical", "rad"),
-    "omega": ("tilt rate", "rad s-1"),
-}
 #: Everything tmem writes into an output directory; a directory holding only these may be replaced.
 OUTPUT_FILES = frozenset(
     {"summary.json", "trajectory.nc", "velocity.png", "distance.png", "formation.png", "animation.gif", "report.md"}
@@ -67,8 +60,8 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     over_agents = ("time", "agent", "axis")
     over_pairs = ("time", "pair")
     data = {}
-    for m, name in enumerate(STATE_NAMES):
-        long_name, units = _STATE_ATTRS[name]
+    model = trajectory.model
+    for m, (name, long_name, units) in enumerate(zip(model.state_names, model.long_names, model.state_units)):
         data[name] = (over_agents, trajectory.state[..., m], {"long_name": long_name, "units": units})
     data["U"] = (over_agents, trajectory.control, {"long_name": "tilt set-point (control)", "units": "rad"})
     data["active"] = (("time", "agent"), trajectory.active.astype(np.int8), {"long_name": "agent flying", "units": "1"})
@@ -82,7 +75,7 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     data["d_t"] = ("pair", trajectory.d_t, {"long_name": "set distance of the pair", "units": "m"})
     data["rms_velocity"] = (
         ("time",),
-        metrics.rms_velocity(trajectory.state[..., 1], trajectory.active),
+        metrics.rms_velocity(model.velocity(trajectory.state), trajectory.active),
         {"long_name": "RMS velocity over the recorded agents flying", "units": "m s-1"},
     )
     attrs = {

@@ -124,14 +124,15 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
 
 def direction_error_deg(trajectory: Trajectory) -> float | None:
     """Largest angle (degrees) between a recorded pair's direction and the one it must hold."""
-    direction = trajectory.setup.direction
+    direction = trajectory.initial.direction
     position = {int(a): q for q, a in enumerate(trajectory.agents)}
     worst = None
     for p, (i, j) in enumerate(trajectory.pairs.tolist()):
         if np.isnan(direction[p, 0]) or i not in position or j not in position:
             continue
-        delta = trajectory.state[:, position[j], :, 0] - trajectory.state[:, position[i], :, 0]
-        box = trajectory.setup.box
+        where = trajectory.model.position(trajectory.state)
+        delta = where[:, position[j]] - where[:, position[i]]
+        box = trajectory.initial.box
         delta = np.where(box > 0, delta - box * np.round(delta / np.where(box > 0, box, 1.0)), delta)
         cosine = (delta @ direction[p]) / np.linalg.norm(delta, axis=1)
         angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))[trajectory.flag[:, p] == 1]
@@ -161,11 +162,12 @@ def summarize(trajectory: Trajectory) -> dict:
     ``uncouple_time`` the first such event of any pair.
     """
     scenario = trajectory.scenario
+    model = trajectory.model
     rms = [
-        rms_velocity(trajectory.setup.state[..., 1], trajectory.setup.active),
-        rms_velocity(trajectory.final_state[..., 1], trajectory.final_active),
+        rms_velocity(model.velocity(trajectory.initial.state), trajectory.initial.active),
+        rms_velocity(model.velocity(trajectory.final_state), trajectory.final_active),
     ]
-    box = trajectory.setup.box
+    box = trajectory.initial.box
     min_pairs = float(trajectory.min_distance.min()) if len(trajectory.min_distance) else np.inf
     min_distance = min(min_pairs, trajectory.min_neighbor_distance)
     return {
@@ -179,11 +181,11 @@ def summarize(trajectory: Trajectory) -> dict:
         "rms_velocity_final": float(rms[1]),
         "rms_change_percent": float(100.0 * (rms[1] / rms[0] - 1.0)) if rms[0] > 0 else None,
         "min_distance": float(min_distance) if np.isfinite(min_distance) else None,
-        "final_distance": nearest_distance(trajectory.final_state[:, :, 0], trajectory.final_active, box),
+        "final_distance": nearest_distance(model.position(trajectory.final_state), trajectory.final_active, box),
         "coupled": any(e.kind == "couple" for e in trajectory.events),
         "couple_time": _first([e.time for e in trajectory.events if e.kind == "couple"]),
         "uncouple_time": _first([e.time for e in trajectory.events if e.kind == "uncouple"]),
-        "final_velocities": trajectory.final_state[..., 1].tolist() if trajectory.final_state.shape[0] <= 100 else None,
+        "final_velocities": model.velocity(trajectory.final_state).tolist() if trajectory.final_state.shape[0] <= 100 else None,
         "events": summarize_events(trajectory.events),
         "gains": trajectory.gains.tolist(),
         "formation": formation_summary(trajectory),

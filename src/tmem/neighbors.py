@@ -30,6 +30,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from . import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+
 
 def all_pairs(active: np.ndarray) -> np.ndarray:
     """Every pair ``(i, j)``, ``i < j``, of active agents, once, sorted: shape (pairs, 2), unsigned."""
@@ -46,6 +48,12 @@ def nearest_image(delta, side):
     if side > 0.0:
         return delta - side * np.floor(delta / side + 0.5)
     return delta
+
+
+@numba.njit(cache=True, inline="always")
+def into_box(position, side):
+    """``position`` taken into ``[0, side)`` along a periodic axis (``side > 0``)."""
+    return position - side * np.floor(position / side)
 
 
 @numba.njit(cache=True)
@@ -96,7 +104,7 @@ def _cells(points, active, cutoff, box):
             for a in range(axes):
                 position = points[i, a] - lo[a]
                 if box[a] > 0.0:
-                    position -= box[a] * np.floor(position / box[a])
+                    position = into_box(position, box[a])
                 k = min(int(position / size[a]), shape[a] - 1)
                 c = c * shape[a] + k
             cell_of[i] = c

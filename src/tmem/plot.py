@@ -46,7 +46,7 @@ def velocity_figure(trajectory: Trajectory):
     """Velocities of (up to MAX_DRAWN) agents and the RMS velocity against time."""
     fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
     t = trajectory.time
-    velocity = trajectory.state[..., 1]
+    velocity = trajectory.model.velocity(trajectory.state)
     one_axis = velocity.shape[2] == 1
     for q in range(min(MAX_DRAWN, velocity.shape[1])):
         value = velocity[:, q, 0] if one_axis else np.linalg.norm(velocity[:, q], axis=1)

@@ -21,7 +21,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .formation import generate
-from .interaction import uses_coupling
+from .interaction.registry import FUNCTION_NAMES, uses_coupling
 
 PRESETS = ("fig5", "fig7", "fig9", "repulsion")
 
@@ -48,6 +48,7 @@ MAX_RECORD_BYTES = 8 * 2**30
 class ModelParams(StrictModel):
     """Quadrocopter model (1)-(2), Table 1."""
 
+    kind: Literal["linear"] = "linear"
     kp: Positive = 6.0
     kd: Positive = 25.0
     g: Positive = 9.8
@@ -71,7 +72,7 @@ class ControllerParams(StrictModel):
 class InteractionParams(StrictModel):
     """Interaction function and its parameters, (7)-(11)."""
 
-    function: Literal["repulsion", "attraction", "switching", "improved"] = "improved"
+    function: Literal[FUNCTION_NAMES] = "improved"
     radius: Positive = 20.0
     c_max: Positive = 0.1
     d_t: Positive = 35.0
@@ -102,7 +103,12 @@ class SimulationParams(StrictModel):
 
     @property
     def n_steps(self) -> int:
-        return int(round(self.duration / self.dt))
+        """Steps of ``dt`` in ``duration``."""
+        return self.step_of(self.duration)
+
+    def step_of(self, time: float) -> int:
+        """The step at which something due at ``time`` (s) happens: the nearest whole step."""
+        return int(round(time / self.dt))
 
     @model_validator(mode="after")
     def _whole_steps(self) -> "SimulationParams":

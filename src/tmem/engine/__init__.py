@@ -1,0 +1,23 @@
+"""The engine: a scenario in, a recorded trajectory and its events out.
+
+The step, for every agent at every step ``k`` (time ``k dt``), in the order
+the compiled loop runs it (:mod:`tmem.engine.loop`)::
+
+    commands -> measurement -> P* (6) -> neighbour pushes (8) -> formation pairs (9)-(11)
+             -> record -> saturate |U| <= c_max -> the vehicle's step over dt
+
+* :mod:`tmem.engine.records` — the named records the stages work on;
+* :mod:`tmem.engine.stages` — one compiled function per stage;
+* :mod:`tmem.engine.loop` — the loop, compiled once per vehicle model;
+* :mod:`tmem.engine.driver` — builds the records from a scenario and drives the loop;
+* :mod:`tmem.engine.trajectory` — what a run returns.
+
+``docs/architecture.md`` describes each stage and record, and how to extend them.
+"""
+
+from __future__ import annotations
+
+from .driver import record_steps, simulate
+from .trajectory import DIVERGED, Event, SimulationError, Trajectory
+
+__all__ = ["DIVERGED", "Event", "SimulationError", "Trajectory", "record_steps", "simulate"]

@@ -1,0 +1,259 @@
+"""The driver of a run: the records built, the compiled loop driven in chunks, the trajectory read back.
+
+:func:`simulate` builds the records of :mod:`tmem.engine.records` from a
+scenario, lists the neighbouring pairs (:mod:`tmem.neighbors`), and runs the
+compiled loop (:mod:`tmem.engine.loop`) in chunks that last about
+``chunk_seconds``, so that a caller can show progress between them.  When the
+loop reports that the lists are stale (an agent's ``P*`` moved half the skin,
+or an agent was removed or added), it lists them again and goes on from the
+same step.  At the end it translates slots back to the scenario's agents.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable
+
+import numba
+import numpy as np
+
+from .. import coupling
+from ..control import gains_for, interaction_point
+from ..initial import InitialArrays, build
+from ..interaction.kernels import FunctionParams
+from ..interaction.registry import code, uses_coupling
+from ..model import vehicle_model
+from ..neighbors import all_pairs, arrange, spatial_order, verlet_pairs
+from ..scenario import Scenario
+from ..sensing import Sensing, exact
+from .loop import advance_for
+from .records import (
+    COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Law, Neighbours, Pairs, Records, Run,
+)  # fmt: skip
+from .trajectory import DIVERGED, Event, SimulationError, Trajectory
+
+#: Swarms at least this large use Verlet lists ("auto").
+LARGE_SWARM = 64
+#: Swarms at least this large step on threads: below, starting the threads at every step costs more
+#: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal
+#: at 10^4).
+THREADED_SWARM = 10_000
+#: Agents per block of the neighbour sums (:func:`tmem.neighbors.arrange`); it fixes the order of
+#: each agent's sum, so results do not depend on the number of threads.
+BLOCK = 4096
+
+
+def record_steps(n_steps: int, record_every: int) -> np.ndarray:
+    """The step indices that are recorded: multiples of ``record_every`` and the last step."""
+    steps = np.arange(0, n_steps + 1, record_every)
+    if steps[-1] != n_steps:
+        steps = np.append(steps, n_steps)
+    return steps
+
+
+def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
+    """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters."""
+    ia = scenario.interaction
+    couples = uses_coupling(ia.function)
+    law = Law(
+        gains=gains,
+        function=code(ia.function),
+        neighbour_function=code("repulsion") if couples else code(ia.function),
+        couples=couples,
+        at_crossing=ia.switch_at == "crossing",
+        eps=ia.eps,
+    )
+    return law, FunctionParams(gains[0], ia.reach, ia.d_t, ia.c_max)
+
+
+def _commands(scenario: Scenario, edges: np.ndarray, slot: np.ndarray) -> Commands:
+    """Commands as arrays: step, kind, and targets (pair indices, or the agent's slot) in rows."""
+    index = {(int(i), int(j)): e for e, (i, j) in enumerate(edges)}
+    commands = sorted(scenario.commands, key=lambda cmd: cmd.time)
+    step = np.array([scenario.simulation.step_of(cmd.time) for cmd in commands], dtype=np.int64)
+    kind = np.array([COMMANDS.index(cmd.action) for cmd in commands], dtype=np.int64)
+    targets = []
+    for cmd in commands:
+        if cmd.agent is not None:
+            targets.append([slot[cmd.agent]])
+        else:
+            targets.append([index[(min(i, j), max(i, j))] for i, j in cmd.targets or []])
+    ptr = np.cumsum([0] + [len(t) for t in targets]).astype(np.int64)
+    flat = np.array([t for row in targets for t in row], dtype=np.int64)
+    return Commands(step, kind, ptr, flat)
+
+
+def _partners(n_agents: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each agent's formation partners, in rows ``(ptr, idx)``."""
+    both = np.concatenate([edges, edges[:, ::-1]]) if len(edges) else np.empty((0, 2), dtype=np.int64)
+    order = np.lexsort((both[:, 1], both[:, 0]))
+    both = both[order]
+    ptr = np.searchsorted(both[:, 0], np.arange(n_agents + 1)).astype(np.int64)
+    return ptr, both[:, 1].astype(np.int64).copy()
+
+
+class _NeighbourLister:
+    """Lists the pairs of flying agents in the loop's order, with Verlet lists or every pair."""
+
+    def __init__(self, scenario: Scenario, n_agents: int, n_axes: int, edges_in_slots: np.ndarray, use_lists: bool):
+        self.cutoff = scenario.interaction.reach + scenario.neighbors.skin
+        self.use_lists = use_lists
+        self.adj_ptr, self.adj_idx = _partners(n_agents, edges_in_slots)
+        self.block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
+        self.block_nearest2 = np.empty(len(self.block_ptr) - 1)
+        self.closest = np.full(1, np.inf)  # the smallest squared distance between neighbours so far
+        self.p_ref = np.zeros((n_agents, n_axes))
+        if use_lists:  # pairs are unsigned, as all_pairs gives them: no negative-index check in the loop
+            self.pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)
+            self.found = np.empty((2, len(self.pairs) + 64), dtype=np.int32)
+        self.builds = 0
+
+    def list(self, active: np.ndarray, box: tuple) -> Neighbours:
+        """The pairs within reach and skin of each other in ``p_ref``, each once; grow the arrays if needed."""
+        if self.use_lists:
+            parts = numba.get_num_threads()
+            listed, room = verlet_pairs(self.p_ref, active, self.cutoff, box, self.pairs, self.found, parts)
+            if listed > len(self.pairs) or room > self.found.shape[1]:
+                self.pairs = np.empty((int(1.5 * max(listed, len(self.pairs))) + 16, 2), dtype=np.uint32)
+                self.found = np.empty((2, int(1.5 * max(room, self.found.shape[1])) + 16), dtype=np.int32)
+                verlet_pairs(self.p_ref, active, self.cutoff, box, self.pairs, self.found, parts)
+            self.builds += 1
+        else:
+            self.pairs = all_pairs(active)
+            listed = len(self.pairs)
+        n_inside, n_pairs = arrange(self.pairs, listed, self.adj_ptr, self.adj_idx, BLOCK, self.block_ptr)
+        return Neighbours(self.pairs, n_inside, n_pairs, self.block_ptr, self.p_ref, self.block_nearest2, self.closest)
+
+
+def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int) -> Records:
+    rows = n_steps_recorded
+    return Records(
+        slots=slots,
+        state=np.empty((rows, len(rec_agents), n_axes, n_state)),
+        control=np.empty((rows, len(rec_agents), n_axes)),
+        active=np.empty((rows, len(rec_agents)), dtype=np.bool_),
+        flag=np.empty((rows, n_edges), dtype=np.int64),
+        distance=np.empty((rows, n_edges)),
+        measure=np.empty((rows, n_edges)),
+    )
+
+
+def _events(capacity: int) -> Events:
+    return Events(*(np.empty(capacity, dtype=np.int64) for _ in Events._fields))
+
+
+def _read_events(events: Events, n_events: int, order: np.ndarray, dt: float) -> list[Event]:
+    found = []
+    for e in range(n_events):
+        kind = coupling.EVENT_KINDS[events.kind[e]]
+        agents = tuple(int(order[v]) for v in (events.i[e], events.j[e]) if v >= 0)
+        action = COMMANDS[events.action[e]] if kind == "command" else None
+        found.append(Event(time=round(float(events.step[e] * dt), 12), kind=kind, agents=agents, action=action))
+    return found
+
+
+def simulate(
+    scenario: Scenario,
+    progress: Callable[[int, int], None] | None = None,
+    chunk_seconds: float = 0.1,
+    record: bool = True,
+    sensing: Sensing | None = None,
+) -> Trajectory:
+    """Run a scenario and return its :class:`~tmem.engine.trajectory.Trajectory`.
+
+    Parameters
+    ----------
+    scenario
+        A validated scenario.
+    progress
+        Called as ``progress(steps_done, steps_total)`` between chunks of the
+        compiled loop; chunks last about ``chunk_seconds``.
+    chunk_seconds
+        The wall time a chunk aims at (s).
+    record
+        ``False`` records nothing but the end state (for benchmarks).
+    sensing
+        What the agents know of each other (:mod:`tmem.sensing`); default: every state exactly.
+
+    Returns
+    -------
+    Trajectory
+
+    Raises
+    ------
+    SimulationError
+        If the run diverged.
+    """
+    sim = scenario.simulation
+    model = vehicle_model(scenario.model)
+    gains = gains_for(*model.linearisation(), scenario.controller.r_l, scenario.controller.im_l, scenario.controller.im_r)
+    initial: InitialArrays = build(scenario)
+    n_agents, n_axes, n_state = initial.state.shape
+    box = tuple(initial.box.tolist())
+    method = scenario.neighbors.method
+    use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
+    run = Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
+    law, params = law_of(scenario, gains)
+    vehicle = model.step_params(sim.dt)
+
+    # The loop keeps agent order[s] in slot s: a spatial order, with neighbours close in memory.
+    order = spatial_order(interaction_point(initial.state, gains), initial.active, run.skin + scenario.interaction.reach, initial.box)
+    slot = np.empty(n_agents, dtype=np.int64)
+    slot[order] = np.arange(n_agents)
+    x = initial.state[order]
+    agents = Agents(x, x.copy(), initial.active[order], np.empty((n_agents, n_axes, 2)), np.zeros((n_agents, n_axes)))
+    edges = initial.edges
+    n_edges = len(edges)
+    pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
+                  np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf))  # fmt: skip
+    commands = _commands(scenario, edges, slot)
+
+    steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
+    rec_agents = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
+    rec_agents = rec_agents if record else rec_agents[:0]
+    records = _records(len(steps), rec_agents, slot[rec_agents], n_axes, n_state, n_edges)
+    # A pair changes flag at most once before any command and twice after each.
+    events = _events(n_edges * (1 + 2 * len(commands.step)) + len(commands.step))
+    counters = Counters.zero()
+
+    lister = _NeighbourLister(scenario, n_agents, n_axes, np.stack([pairs.i, pairs.j], axis=1), use_lists)
+    lister.p_ref[:] = interaction_point(x, gains)  # P* (6) at the start
+    neighbours = lister.list(agents.active, box)
+    advance = advance_for(type(model), n_agents >= THREADED_SWARM)
+    sensing = exact(x) if sensing is None else sensing
+    chunk = 1000
+    while counters.step[0] <= sim.n_steps:
+        started = _time.perf_counter()
+        stop = min(counters.step[0] + chunk, sim.n_steps + 1)
+        status = advance(stop, run, law, params, vehicle, sensing, agents, pairs, neighbours, commands, records, events, counters)
+        if status == LISTS_STALE:
+            neighbours = lister.list(agents.active, box)  # and go on from the same step
+            continue
+        elapsed = _time.perf_counter() - started
+        if progress is not None:
+            progress(min(int(counters.step[0]), sim.n_steps), sim.n_steps)
+        # Grow chunks towards about chunk_seconds each (the first includes compilation).
+        chunk = int(min(max(chunk * 4, 1000), max(1000, chunk * chunk_seconds / max(elapsed, 1e-9))))
+
+    if not np.all(np.isfinite(x[agents.active])):
+        raise SimulationError(DIVERGED)
+    return Trajectory(
+        scenario=scenario,
+        initial=initial,
+        model=model,
+        gains=gains,
+        time=steps * sim.dt,
+        agents=rec_agents,
+        state=records.state,
+        control=records.control,
+        active=records.active,
+        flag=records.flag,
+        pair_distance=records.distance,
+        interaction_distance=records.measure,
+        min_distance=pairs.min_distance,
+        min_neighbor_distance=float(np.sqrt(lister.closest[0])),
+        final_state=x[slot],
+        final_active=agents.active[slot],
+        events=_read_events(events, int(counters.n_events[0]), order, sim.dt),
+        list_builds=lister.builds,
+    )

@@ -1,0 +1,83 @@
+"""The step loop: the stages of :mod:`tmem.engine.stages` in order, compiled once per vehicle model.
+
+:func:`advance_for` gives the loop of a vehicle model, serial or on threads.
+The loop's source is written once (:func:`_advance_source`); each model gets
+its own compiled copy with the model's step kernel bound to the name
+``vehicle_step``, so the model's step is inlined and a model costs nothing at
+run time.  Each copy has a name of its own: Numba keys its on-disk cache by
+the function's name, not by ``parallel`` or by what a global name is bound
+to, and copies sharing a name would stand in for each other.
+"""
+
+from __future__ import annotations
+
+import types
+from functools import cache
+
+import numba
+import numpy as np
+
+from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from ..neighbors import into_box
+from ..sensing import measure
+from .records import DONE, LISTS_STALE
+from .stages import apply_commands, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record, tilt_scale
+
+
+def vehicle_step(x, u, i, scale, params, n_axes):
+    """Placeholder for the vehicle model's compiled step, bound by :func:`advance_for`."""
+    raise NotImplementedError("the step loop is compiled by advance_for, which binds the vehicle model's step")
+
+
+def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, neighbours, commands, records, events, counters):
+    """Advance from step ``counters.step`` to ``k_stop``; return ``DONE``, or ``LISTS_STALE`` when the
+    neighbour lists must be built before the step ``counters.step`` (the caller builds them from
+    ``neighbours.p_ref`` and calls again).
+
+    Each step: commands -> measurement -> P* (6) -> neighbour pushes -> formation pairs ->
+    record -> saturate the set-point and step the vehicles (held over ``dt``)."""
+    box = run.box
+    n_axes = len(box)
+    c_max = params.c_max
+    x = agents.state
+    u = agents.setpoint
+    active = agents.active
+    for k in range(counters.step[0], k_stop):
+        counters.step[0] = k
+        rebuild = apply_commands(k, commands, agents, pairs, events, counters)
+        known = measure(x, sensing)
+        moved2 = corrected_positions(known, agents, law, run, neighbours)
+        if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
+            neighbours.p_ref[:] = agents.corrected[:, :, 0]
+            return LISTS_STALE
+        neighbour_pushes(agents, neighbours, law, params, run)
+        formation_pairs(k, agents, pairs, law, params, run, events, counters)
+        if is_recorded(k, run):
+            record(agents, pairs, records, c_max, run, counters)
+        if k < run.n_steps:
+            for i in numba.prange(x.shape[0]):
+                if active[i]:
+                    vehicle_step(x, u, i, tilt_scale(u, i, n_axes, c_max), vehicle, n_axes)
+                    for a in range(n_axes):
+                        if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
+                            x[i, a, 0] = into_box(x[i, a, 0], box[a])
+    counters.step[0] = k_stop
+    return DONE
+
+
+@cache
+def advance_for(model_class, threaded: bool):
+    """The compiled loop of a vehicle model (a :class:`tmem.model.base.VehicleModel` subclass).
+
+    Parameters
+    ----------
+    model_class
+        Its ``step`` kernel is bound to ``vehicle_step``; its ``kind`` names the copy.
+    threaded
+        Per-agent stages and blocks of neighbour sums on threads (large swarms).
+    """
+    name = f"_advance_{model_class.kind}_{'threaded' if threaded else 'serial'}"
+    namespace = dict(_advance_source.__globals__, vehicle_step=model_class.step)
+    source = types.FunctionType(_advance_source.__code__, namespace, name)
+    source.__qualname__ = name
+    return numba.njit(cache=True, parallel=threaded, error_model="numpy")(source)

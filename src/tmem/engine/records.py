@@ -1,0 +1,208 @@
+"""The records the step loop works on: what a run carries from step to step.
+
+Each record is a ``NamedTuple`` of arrays and numbers, so the compiled
+stages take a handful of named records instead of dozens of arguments, and
+Numba compiles them into plain loads and stores.  Arrays are changed in
+place; a record itself is rebuilt only when the neighbour lists are.
+
+Agents live in *slots*, numbered in a spatial order so that neighbours are
+close in memory (:func:`tmem.neighbors.spatial_order`); pairs and records
+name slots.  The engine translates back to the scenario's agent numbers.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+#: Command kinds, in the order of their integer codes.
+COMMANDS = ("uncouple", "couple", "remove", "add")
+UNCOUPLE, COUPLE, REMOVE, ADD = range(4)
+#: What a chunk of the loop returns: it ran to its end, or the neighbour lists must be built first.
+DONE, LISTS_STALE = 0, -1
+
+
+class Law(NamedTuple):
+    """The TMEM controller of every agent: (6)-(11) and the saturation.
+
+    Attributes
+    ----------
+    gains : ndarray, shape (4,)
+        ``K = (K_P, K_V, K_phi, K_omega)``; ``P* = x . K / K_P`` (6).
+    function : int
+        Registry code of the scenario's function, used by the formation pairs.
+    neighbour_function : int
+        Registry code of the function other neighbours use: the scenario's own
+        if it has no flag, else the repulsion (8).
+    couples : bool
+        Whether the function switches on ``F_en``.
+    at_crossing : bool
+        ``interaction.switch_at == "crossing"`` (:func:`tmem.coupling.next_flag`).
+    eps : float
+        The coupling window of (9) (m).
+
+    The interaction functions' parameters travel beside it, as their own
+    record (:class:`~tmem.interaction.kernels.FunctionParams`: ``K_P``,
+    ``R + R_j``, the scenario's ``d_t`` and ``c_max``): a parallel loop takes a
+    record only as an argument of the function it runs in, not as a field.
+    """
+
+    gains: np.ndarray
+    function: int
+    neighbour_function: int
+    couples: bool
+    at_crossing: bool
+    eps: float
+
+
+class Run(NamedTuple):
+    """What stays fixed over a run.
+
+    Attributes
+    ----------
+    n_steps, record_every : int
+        Steps of the run; record every this many (0: record nothing).
+    box : tuple of float
+        Periodic box sides (0 on an open axis); its length is the number of axes,
+        which the loop is compiled for.
+    use_lists : bool
+        Verlet lists (True) or every pair of flying agents.
+    skin : float
+        The lists' skin (m): they are built again once some ``P*`` has moved half of it.
+    """
+
+    n_steps: int
+    record_every: int
+    box: tuple
+    use_lists: bool
+    skin: float
+
+
+class Agents(NamedTuple):
+    """Every agent's state and the set-point summed for it.
+
+    Attributes
+    ----------
+    state : ndarray, shape (agents, axes, n_state)
+    start : ndarray, shape (agents, axes, n_state)
+        Where an added agent starts.
+    active : ndarray, shape (agents,), bool
+        Flying; a removed agent stops where it is and no longer interacts.
+    corrected : ndarray, shape (agents, axes, 2)
+        ``(P*, P)`` on each axis, as the agent's neighbours measure it.
+    setpoint : ndarray, shape (agents, axes)
+        The sum of pushes ``U`` of this step, before saturation.
+    """
+
+    state: np.ndarray
+    start: np.ndarray
+    active: np.ndarray
+    corrected: np.ndarray
+    setpoint: np.ndarray
+
+
+class Pairs(NamedTuple):
+    """The formation pairs (or every pair of a small swarm), each ``(i, j)`` with its flag.
+
+    Attributes
+    ----------
+    i, j : ndarray, shape (pairs,)
+        Slots of the two agents.
+    d_t : ndarray, shape (pairs,)
+        Set distance (m).
+    direction : ndarray, shape (pairs, axes)
+        Required unit direction from ``i`` to ``j``; NaN rows where none is held.
+    flag : ndarray, shape (pairs,), int
+        ``F_en``.
+    armed : ndarray, shape (pairs,), int
+        The operator's intent (:mod:`tmem.coupling`).
+    r_before : ndarray, shape (pairs,)
+        ``|d|`` one step earlier (NaN before the first step).
+    min_distance : ndarray, shape (pairs,)
+        Smallest ``|P_j - P_i|`` so far.
+    """
+
+    i: np.ndarray
+    j: np.ndarray
+    d_t: np.ndarray
+    direction: np.ndarray
+    flag: np.ndarray
+    armed: np.ndarray
+    r_before: np.ndarray
+    min_distance: np.ndarray
+
+
+class Neighbours(NamedTuple):
+    """The other neighbouring pairs, in the loop's order (:func:`tmem.neighbors.arrange`).
+
+    Attributes
+    ----------
+    pairs : ndarray, shape (>= n_pairs, 2), uint32
+    n_inside, n_pairs : int
+        Pairs ``[:n_inside]`` lie within blocks, ``[n_inside:n_pairs]`` cross between them.
+    block_ptr : ndarray
+        Pairs of block ``b``: ``pairs[block_ptr[b]:block_ptr[b + 1]]``.
+    p_ref : ndarray, shape (agents, axes)
+        ``P*`` when the lists were built.
+    block_nearest2 : ndarray, shape (blocks,)
+        Work space: each block's smallest squared distance this step.
+    closest : ndarray, shape (1,)
+        Smallest squared distance of two agents within reach so far.
+    """
+
+    pairs: np.ndarray
+    n_inside: int
+    n_pairs: int
+    block_ptr: np.ndarray
+    p_ref: np.ndarray
+    block_nearest2: np.ndarray
+    closest: np.ndarray
+
+
+class Commands(NamedTuple):
+    """The operator's commands, sorted by step; command ``c`` acts on ``target[ptr[c]:ptr[c + 1]]``.
+
+    ``target`` holds pair indices for couple / uncouple (none: every pair) and
+    the agent's slot for remove / add.
+    """
+
+    step: np.ndarray
+    kind: np.ndarray
+    ptr: np.ndarray
+    target: np.ndarray
+
+
+class Records(NamedTuple):
+    """What is recorded at each recorded step, for the agents in ``slots`` and every pair."""
+
+    slots: np.ndarray
+    state: np.ndarray
+    control: np.ndarray
+    active: np.ndarray
+    flag: np.ndarray
+    distance: np.ndarray
+    measure: np.ndarray
+
+
+class Events(NamedTuple):
+    """Coupling transitions and commands, as they happen: step, kind, agents (slots; -1: none), action."""
+
+    step: np.ndarray
+    kind: np.ndarray
+    i: np.ndarray
+    j: np.ndarray
+    action: np.ndarray
+
+
+class Counters(NamedTuple):
+    """Where the loop stands, kept between chunks (each an array of one integer)."""
+
+    step: np.ndarray
+    next_command: np.ndarray
+    next_record: np.ndarray
+    n_events: np.ndarray
+
+    @classmethod
+    def zero(cls) -> "Counters":
+        return cls(*(np.zeros(1, dtype=np.int64) for _ in cls._fields))

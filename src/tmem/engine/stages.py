@@ -1,0 +1,286 @@
+"""The compiled stages of one step, each one idea, in the order the loop runs them.
+
+Every stage is a Numba function inlined into the loop (:mod:`tmem.engine.loop`)
+and works on the records of :mod:`tmem.engine.records` in place:
+
+1. :func:`apply_commands` — operator commands due at the step;
+2. measurement (:func:`tmem.sensing.measure`) — the states as each agent knows them;
+3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
+   lists have drifted;
+4. :func:`neighbour_pushes` — the pushes of the non-formation neighbours;
+5. :func:`formation_pairs` — each pair's flag ``F_en`` and its pull or push;
+6. :func:`record` — the recorded step;
+7. combining and saturating the set-point (:func:`tilt_scale`) and the
+   vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
+
+Steps 5 and 6 of the agents' update share one pass: the factor that saturates
+the summed set-point on its norm is computed where it is used, which saves a
+pass over every agent.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from .. import coupling
+from ..control import corrected_position
+from ..interaction.kernels import FunctionParams, pair_control
+from ..neighbors import nearest_image
+from .records import ADD, COUPLE, REMOVE
+
+#: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
+CHUNK = 256
+
+
+@numba.njit(cache=True, inline="always")
+def log_event(events, counters, k, kind, i, j, action):
+    """Append an event at step ``k`` (agents as slots, -1 for none; action -1 for none)."""
+    n = counters.n_events[0]
+    events.step[n] = k
+    events.kind[n] = kind
+    events.i[n] = i
+    events.j[n] = j
+    events.action[n] = action
+    counters.n_events[0] = n + 1
+
+
+@numba.njit(cache=True, inline="always")
+def apply_commands(k, commands, agents, pairs, events, counters):
+    """Carry out the commands due at step ``k``; return whether the neighbour lists must be rebuilt.
+
+    ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.coupling`); ``remove`` stops an agent
+    where it is (a lost vehicle), ``add`` puts it back at its start.
+    """
+    rebuild = False
+    while counters.next_command[0] < commands.step.shape[0] and commands.step[counters.next_command[0]] <= k:
+        c = counters.next_command[0]
+        kind = commands.kind[c]
+        first = commands.ptr[c]
+        if kind == REMOVE or kind == ADD:
+            i = commands.target[first]
+            agents.active[i] = kind == ADD
+            rebuild = True  # the pairs listed are those of flying agents
+            if kind == ADD:
+                agents.state[i] = agents.start[i]
+            else:
+                agents.state[i, :, 1:] = 0.0
+            log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind)
+        else:
+            if first == commands.ptr[c + 1]:
+                pairs.armed[:] = 1 if kind == COUPLE else 0
+            for t in range(first, commands.ptr[c + 1]):
+                pairs.armed[commands.target[t]] = 1 if kind == COUPLE else 0
+            single = commands.ptr[c + 1] - first == 1
+            i = pairs.i[commands.target[first]] if single else -1
+            j = pairs.j[commands.target[first]] if single else -1
+            log_event(events, counters, k, coupling.EVENT_COMMAND, i, j, kind)
+        counters.next_command[0] = c + 1
+    return rebuild
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def corrected_positions(known, agents, law, run, neighbours):
+    """``P* = x . K / K_P`` (6) and ``P`` of every agent into ``agents.corrected``; clear the set-points.
+
+    Returns the largest squared shift of a flying agent's ``P*`` since the lists were built (0
+    without lists).
+    """
+    box = run.box
+    n_axes = len(box)
+    use_lists = run.use_lists
+    gains = law.gains
+    corrected = agents.corrected
+    setpoint = agents.setpoint
+    active = agents.active
+    p_ref = neighbours.p_ref
+    moved = 0.0
+    for i in numba.prange(known.shape[0]):
+        shift2 = 0.0
+        for a in range(n_axes):
+            corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains)
+            corrected[i, a, 1] = known[i, a, 0]
+            setpoint[i, a] = 0.0  # the sum of pushes starts here
+            if use_lists:
+                delta = nearest_image(corrected[i, a, 0] - p_ref[i, a], box[a])
+                shift2 += delta * delta
+        moved = max(moved, shift2 if active[i] else 0.0)
+    return moved
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _chunk_pushes(diff, m, n_axes, function, params):
+    """The pushes of ``m`` pairs, in place: ``diff[a]`` holds ``d_a = P*_j - P*_i`` on entry and the
+    push on agent ``i`` along axis ``a``, ``f(|d|) d_a / |d|``, on return (0 beyond reach).
+    ``diff[n_axes + a]`` holds ``P_j - P_i``; ``diff[2 n_axes]`` gets ``|P_j - P_i|^2`` for the
+    pairs within reach, ``inf`` for the others.  No branches: the compiler vectorises it."""
+    reach2 = params.reach * params.reach
+    for t in range(m):
+        r2 = 0.0
+        for a in range(n_axes):
+            r2 += diff[a, t] * diff[a, t]
+        inside = (r2 < reach2) & (r2 > 0.0)
+        r = np.sqrt(r2)
+        push = pair_control(function, r, 0, params) / r
+        push = push if inside else 0.0
+        dist2 = 0.0
+        for a in range(n_axes):
+            dist2 += diff[n_axes + a, t] * diff[n_axes + a, t]
+            diff[a, t] *= push
+        diff[2 * n_axes, t] = dist2 if inside else np.inf
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _pushes_of(corrected, pairs, first, stop, box, function, params, u):
+    """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
+    the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach."""
+    n_axes = len(box)
+    diff = np.empty((2 * n_axes + 1, CHUNK))
+    nearest2 = np.inf
+    for begin in range(first, stop, CHUNK):
+        m = min(CHUNK, stop - begin)
+        for t in range(m):
+            i = pairs[begin + t, 0]
+            j = pairs[begin + t, 1]
+            for a in range(n_axes):
+                diff[a, t] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
+                diff[n_axes + a, t] = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
+        _chunk_pushes(diff, m, n_axes, function, params)
+        for t in range(m):
+            nearest2 = min(nearest2, diff[2 * n_axes, t])
+        for t in range(m):
+            i = pairs[begin + t, 0]
+            j = pairs[begin + t, 1]
+            for a in range(n_axes):
+                u[i, a] += diff[a, t]
+                u[j, a] -= diff[a, t]
+    return nearest2
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def neighbour_pushes(agents, neighbours, law, params, run):
+    """Sum the pushes of every listed non-formation pair within reach, ``f(|d|)`` along ``d / |d|``.
+
+    (Parallel loops take plain arrays and numbers: the records' fields are read out before them.)
+    Each block's own pairs run on a thread of their own, then the pairs crossing between blocks, so
+    every agent adds its pushes in one order whatever the number of threads.  ``f`` is the
+    function of :attr:`Law.neighbour_function`, with the scenario's ``d_t``.
+    """
+    box = run.box
+    function = law.neighbour_function
+    corrected = agents.corrected
+    setpoint = agents.setpoint
+    pairs = neighbours.pairs
+    block_ptr = neighbours.block_ptr
+    block_nearest2 = neighbours.block_nearest2
+    for b in numba.prange(block_ptr.shape[0] - 1):
+        block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params, setpoint)
+    nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint)
+    neighbours.closest[0] = min(neighbours.closest[0], nearest2, block_nearest2.min())
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _pair_geometry(corrected, e, pairs, box, d):
+    """``d = P*_j - P*_i`` of pair ``e`` into ``d``; return ``(|d|, |P_j - P_i|)`` (nearest images)."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    r2 = 0.0
+    dist2 = 0.0
+    for a in range(len(box)):
+        d[a] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
+        r2 += d[a] * d[a]
+        delta = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
+        dist2 += delta * delta
+    return np.sqrt(r2), np.sqrt(dist2)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
+    """Add pair ``e``'s push to its agents, equal and opposite: (10)/(11) along ``d / |d|``, or, while
+    coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)`` saturated on its norm."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if pairs.flag[e] == 1 and not np.isnan(pairs.direction[e, 0]):
+        norm2 = 0.0
+        for a in range(n_axes):
+            d[a] = params.k_p * (d[a] - pairs.direction[e, a] * pairs.d_t[e])
+            norm2 += d[a] * d[a]
+        scale = min(1.0, params.c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
+        for a in range(n_axes):
+            u[i, a] += scale * d[a]
+            u[j, a] -= scale * d[a]
+    elif r > 0.0:
+        p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
+        push = pair_control(law.function, r, pairs.flag[e], p) / r
+        for a in range(n_axes):
+            u[i, a] += push * d[a]
+            u[j, a] -= push * d[a]
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def formation_pairs(k, agents, pairs, law, params, run, events, counters):
+    """Each formation pair: its flag ``F_en`` after this step's check (:func:`tmem.coupling.next_flag`,
+    (9)), its smallest distance, and its pull or push on both agents.  A pair whose agent was removed
+    uncouples and rests."""
+    d = np.empty(len(run.box))
+    for e in range(pairs.i.shape[0]):
+        i = pairs.i[e]
+        j = pairs.j[e]
+        if not (agents.active[i] and agents.active[j]):
+            if pairs.flag[e] == 1:  # the pair is lost with its agent
+                pairs.flag[e] = 0
+                log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1)
+            pairs.r_before[e] = np.nan
+            continue
+        r, dist = _pair_geometry(agents.corrected, e, pairs, run.box, d)
+        if dist < pairs.min_distance[e]:
+            pairs.min_distance[e] = dist
+        new = pairs.flag[e]
+        if law.couples:
+            new = coupling.next_flag(pairs.flag[e], pairs.armed[e], pairs.r_before[e], r, pairs.d_t[e], law.eps, law.at_crossing)
+        pairs.r_before[e] = r
+        if new != pairs.flag[e]:
+            pairs.flag[e] = new
+            log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1)
+        _pair_pull(e, d, r, pairs, law, params, len(run.box), agents.setpoint)
+
+
+@numba.njit(cache=True, inline="always")
+def tilt_scale(u, i, n_axes, c_max):
+    """The factor that saturates agent ``i``'s summed set-point on its norm, ``|U| <= c_max``."""
+    norm2 = 0.0
+    for a in range(n_axes):
+        norm2 += u[i, a] * u[i, a]
+    return c_max / np.sqrt(norm2) if norm2 > c_max * c_max else 1.0
+
+
+@numba.njit(cache=True, inline="always")
+def is_recorded(k, run):
+    """Whether step ``k`` is recorded: a multiple of ``record_every``, and the last step."""
+    return run.record_every > 0 and (k % run.record_every == 0 or k == run.n_steps)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def record(agents, pairs, records, c_max, run, counters):
+    """Record the step, before the vehicles move, with the saturated set-point applied over it."""
+    n_axes = len(run.box)
+    q_record = counters.next_record[0]
+    for q in range(records.slots.shape[0]):
+        i = records.slots[q]
+        records.state[q_record, q] = agents.state[i]
+        records.active[q_record, q] = agents.active[i]
+        scale = tilt_scale(agents.setpoint, i, n_axes, c_max) if agents.active[i] else 0.0
+        for a in range(n_axes):
+            records.control[q_record, q, a] = agents.setpoint[i, a] * scale
+    for e in range(pairs.i.shape[0]):
+        records.flag[q_record, e] = pairs.flag[e]
+        dist2 = 0.0
+        r2 = 0.0
+        for a in range(n_axes):
+            delta = nearest_image(agents.state[pairs.j[e], a, 0] - agents.state[pairs.i[e], a, 0], run.box[a])
+            dist2 += delta * delta
+            delta = nearest_image(agents.corrected[pairs.j[e], a, 0] - agents.corrected[pairs.i[e], a, 0], run.box[a])
+            r2 += delta * delta
+        records.distance[q_record, e] = np.sqrt(dist2)
+        records.measure[q_record, e] = np.sqrt(r2)
+    counters.next_record[0] = q_record + 1

@@ -1,0 +1,102 @@
+"""What a run produced: the trajectory, its events, and a run that failed."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..initial import InitialArrays
+from ..model.base import VehicleModel
+from ..scenario import Scenario
+
+
+class SimulationError(ValueError):
+    """A run that could not be completed; the message is one line."""
+
+
+DIVERGED = "the run diverged (non-finite agent states); check the model and controller values and dt"
+
+
+@dataclass(frozen=True)
+class Event:
+    """A coupling transition, or an operator command (``agents`` empty for several or every pair)."""
+
+    time: float
+    kind: str  # "command" | "couple" | "uncouple"
+    agents: tuple[int, ...]
+    action: str | None = None  # for commands: "couple" | "uncouple" | "remove" | "add"
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """What a run produced.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    initial : InitialArrays
+        The initial arrays: states, flying agents, pairs with their ``d_t`` and
+        directions, the periodic box.
+    model : VehicleModel
+        The vehicle model: state names, units and the indices of position,
+        velocity and tilt in ``state``.
+    gains : ndarray, shape (4,)
+        ``K = (K_P, K_V, K_phi, K_omega)``.
+    time : ndarray, shape (n_records,)
+    agents : ndarray, shape (n_recorded,)
+        Indices of the recorded agents.
+    state : ndarray, shape (n_records, n_recorded, axes, 4)
+        The state at each recorded time, named by ``model.state_names``
+        (the linear model's ``(P, V, phi, omega)``).
+    control : ndarray, shape (n_records, n_recorded, axes)
+        The tilt set-point ``U`` applied from that time on.
+    active : ndarray, shape (n_records, n_recorded), bool
+        Whether each agent was flying.
+    flag : ndarray, shape (n_records, n_pairs)
+        ``F_en`` of each pair at each recorded time (after that step's check).
+    pair_distance : ndarray, shape (n_records, n_pairs)
+        ``|P_j - P_i|`` of each pair (nearest image).
+    interaction_distance : ndarray, shape (n_records, n_pairs)
+        ``|d| = |P*_j - P*_i|`` (6) of each pair.
+    min_distance : ndarray, shape (n_pairs,)
+        Smallest distance of each formation pair over every step.
+    min_neighbor_distance : float
+        Smallest distance between any two agents within ``R + R_j`` of each
+        other (in ``P*``) at any step; ``inf`` if no two came so close.
+    final_state : ndarray, shape (agents, axes, 4)
+        Every agent's state at the end.
+    final_active : ndarray, shape (agents,), bool
+    events : list of Event
+    list_builds : int
+        How often the neighbour lists were built.
+    """
+
+    scenario: Scenario
+    initial: InitialArrays
+    model: VehicleModel
+    gains: np.ndarray
+    time: np.ndarray
+    agents: np.ndarray
+    state: np.ndarray
+    control: np.ndarray
+    active: np.ndarray
+    flag: np.ndarray
+    pair_distance: np.ndarray
+    interaction_distance: np.ndarray
+    min_distance: np.ndarray
+    min_neighbor_distance: float
+    final_state: np.ndarray
+    final_active: np.ndarray
+    events: list[Event]
+    list_builds: int
+
+    @property
+    def pairs(self) -> np.ndarray:
+        """The pairs handled one by one (:meth:`Scenario.pairs`), shape (n_pairs, 2)."""
+        return self.initial.edges
+
+    @property
+    def d_t(self) -> np.ndarray:
+        """Set distance of each pair, shape (n_pairs,)."""
+        return self.initial.d_t

@@ -1,0 +1,24 @@
+"""Vehicle models behind one contract (:class:`tmem.model.base.VehicleModel`).
+
+:data:`MODELS` is the registry: the scenario's ``[model] kind`` and the class
+that implements it, imported only when a run needs it (validating a scenario
+loads no compiled code).  Adding a model is one module in this package, one
+row here and its parameters table in the scenario schema
+(``docs/architecture.md``).
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+#: ``kind -> "module:Class"`` of each vehicle model.
+MODELS: dict[str, str] = {
+    "linear": "tmem.model.linear:LinearModel",
+}
+
+
+def vehicle_model(params: Any):
+    """The :class:`~tmem.model.base.VehicleModel` for a scenario's ``[model]`` table (by its ``kind``)."""
+    module, name = MODELS[params.kind].split(":")
+    return getattr(import_module(module), name)(params)
