@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from . import _numba_cache  # noqa: F401  (drops stale compiled caches before any load)
 from . import coupling, interaction
 from .control import modal_gains
 from .model import state_matrices, zero_order_hold

@@ -40,6 +40,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from . import _numba_cache  # noqa: F401  (drops stale compiled caches before any load)
+
 #: Interaction function names, in the order of their integer codes.
 FUNCTIONS = ("repulsion", "attraction", "switching", "improved")
 REPULSION, ATTRACTION, SWITCHING, IMPROVED = range(4)

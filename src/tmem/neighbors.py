@@ -30,6 +30,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from . import _numba_cache  # noqa: F401  (drops stale compiled caches before any load)
+
 
 def all_pairs(active: np.ndarray) -> np.ndarray:
     """Every pair ``(i, j)``, ``i < j``, of active agents, once, sorted: shape (pairs, 2), unsigned."""

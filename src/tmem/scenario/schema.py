@@ -16,7 +16,7 @@ import numpy as np
 from pydantic import model_validator
 
 from ..formation import generate
-from ..interaction import uses_coupling
+from ..interaction_names import uses_coupling
 from .tables import (
     Agent,
     Command,

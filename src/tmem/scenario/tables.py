@@ -13,6 +13,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from ..interaction_names import FUNCTION_NAMES
+
 
 class ScenarioError(ValueError):
     """A scenario that cannot be run; the message is one line naming the field."""
@@ -66,7 +68,7 @@ class ControllerParams(StrictModel):
 class InteractionParams(StrictModel):
     """Interaction function and its parameters, (7)-(11)."""
 
-    function: Literal["repulsion", "attraction", "switching", "improved"] = "improved"
+    function: Literal[FUNCTION_NAMES] = "improved"
     radius: Positive = 20.0
     c_max: Positive = 0.1
     d_t: Positive = 35.0
