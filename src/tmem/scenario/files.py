@@ -18,13 +18,19 @@ from typing import Any
 from pydantic import ValidationError
 
 from .schema import Scenario
-from .tables import FieldError, ScenarioError
+from .tables import MODEL_KINDS, FieldError, ScenarioError
 
 #: The shipped scenarios, ``src/tmem/presets/NAME.toml``.
 PRESETS = ("fig5", "fig7", "fig9", "repulsion")
 
 
+#: Tables chosen by a kind: pydantic names the kind in a location (``model.linear.kp``); a file does not.
+_KINDS = {"model": MODEL_KINDS}
+
+
 def _location(loc: tuple) -> str:
+    if len(loc) > 1 and loc[1] in _KINDS.get(loc[0], ()):
+        loc = loc[:1] + loc[2:]
     text = ""
     for part in loc:
         text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
@@ -33,6 +39,7 @@ def _location(loc: tuple) -> str:
 
 _REWORDING = (
     ("Input should be a valid dictionary or instance of", "must be a table, a"),
+    ("Input should be a valid dictionary or object to extract fields from", "must be a table"),
     ("List should have", "must have"),
     ("Input should be", "must be"),
     (" after validation", ""),
@@ -48,6 +55,10 @@ def _explain(error: dict) -> str:
         reason = "is required"
     elif kind == "finite_number":
         reason = f"must be a finite number, got {error['input']}"
+    elif kind == "union_tag_invalid":  # a table chosen by kind, of an unknown kind
+        key = error["ctx"]["discriminator"].strip("'")
+        where, tags = f"{where}.{key}", error["ctx"]["expected_tags"]
+        reason = f"must be {'one of ' if ',' in tags else ''}{tags}, got {error['input'][key]!r}"
     else:
         ctx_error = error.get("ctx", {}).get("error")
         if isinstance(ctx_error, FieldError):

@@ -24,6 +24,7 @@ from .tables import (
     FieldError,
     FormationParams,
     InteractionParams,
+    LinearModelParams,
     ModelParams,
     NeighborParams,
     SimulationParams,
@@ -54,7 +55,7 @@ class Scenario(StrictModel):
     """
 
     name: str = ""
-    model: ModelParams = ModelParams()
+    model: ModelParams = LinearModelParams()
     controller: ControllerParams = ControllerParams()
     interaction: InteractionParams = InteractionParams()
     simulation: SimulationParams = SimulationParams()

@@ -9,9 +9,9 @@ spans fields raises :class:`FieldError` naming the field at fault.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
 from ..interaction_names import FUNCTION_NAMES
 
@@ -42,12 +42,31 @@ NonNegative = Annotated[float, Field(ge=0, le=LIMIT)]
 Pair = Annotated[list[int], Field(min_length=2, max_length=2)]
 
 
-class ModelParams(StrictModel):
-    """Quadrocopter model (1)-(2), Table 1."""
+class LinearModelParams(StrictModel):
+    """Quadrocopter model (1)-(2), linear per axis, Table 1: ``[model] kind = "linear"``."""
 
+    kind: Literal["linear"] = "linear"
     kp: Positive = 6.0
     kd: Positive = 25.0
     g: Positive = 9.8
+
+
+def _linear_unless_named(table: object) -> object:
+    """A ``[model]`` table without ``kind`` is the linear model, as before kinds were named."""
+    if isinstance(table, dict) and "kind" not in table:
+        return {"kind": "linear", **table}
+    return table
+
+
+#: The ``[model]`` table: one class per vehicle model, chosen by its ``kind`` (add a class to the
+#: union for a new kind; pydantic then reports an unknown kind as ``model.kind``).
+ModelParams = Annotated[
+    Union[LinearModelParams],  # noqa: UP007  (one kind so far; `X | Y` needs two)
+    BeforeValidator(_linear_unless_named),
+    Field(discriminator="kind"),
+]
+#: The model kinds a scenario may name.
+MODEL_KINDS: tuple[str, ...] = ("linear",)
 
 
 class ControllerParams(StrictModel):
