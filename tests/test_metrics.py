@@ -6,7 +6,7 @@ import pytest
 import tmem
 from tmem.engine import Event, Trajectory
 from tmem.metrics import nearest_distance, pair_summary, rms_velocity, summarize
-from tmem.setup import build
+from tmem.initial import build
 
 
 def made(distance, flag, events, velocities=None):
@@ -19,7 +19,7 @@ def made(distance, flag, events, velocities=None):
         state[:, :, 0, 1] = velocities
     return Trajectory(
         scenario=scenario,
-        setup=build(scenario),
+        initial=build(scenario),
         gains=np.ones(4),
         time=np.arange(n, dtype=float),
         agents=np.array([0, 1]),
@@ -62,7 +62,7 @@ def test_never_coupled_pair_has_no_coupling_figures():
 def test_summary_rms_change_from_known_speeds():
     tr = made([50, 50], [0, 0], [], velocities=np.array([[3.0, -1.5], [3.0, -1.5]]))
     s = summarize(tr)
-    # The setup holds Table 2's start, (-1.5, 3.0); the end speeds here are (3, -1.5): the same RMS.
+    # The initial arrays hold Table 2's start, (-1.5, 3.0); the end speeds here are (3, -1.5): the same RMS.
     assert s["rms_velocity_initial"] == pytest.approx(np.sqrt((1.5**2 + 3**2) / 2))
     assert s["rms_change_percent"] == pytest.approx(0.0, abs=1e-12)
 

@@ -134,8 +134,8 @@ def test_periodic_gas_keeps_momentum_and_stays_in_the_box():
     """Pushes across the box edge are equal and opposite too.  With several neighbours, saturating
     an agent's summed set-point breaks that symmetry, so c_max is set too high to saturate here."""
     tr = tmem.simulate(with_changes(random_swarm(300, 2, True, "auto"), {"interaction.c_max": 10.0}))
-    side = tr.setup.box[0]
-    p0 = tr.setup.state[:, :, 1].sum(axis=0)
+    side = tr.initial.box[0]
+    p0 = tr.initial.state[:, :, 1].sum(axis=0)
     np.testing.assert_allclose(tr.final_state[:, :, 1].sum(axis=0), p0, atol=1e-9)
     assert np.all((tr.final_state[:, :, 0] >= 0) & (tr.final_state[:, :, 0] < side))
 

@@ -19,7 +19,7 @@ import tmem
 from tmem.metrics import rms_velocity
 from tmem.reference import final_state
 from tmem.scenario import Scenario, with_changes
-from tmem.setup import build
+from tmem.initial import build
 
 DTS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 

@@ -47,10 +47,10 @@ import numpy as np
 from . import _numba_cache  # noqa: F401  (drops stale compiled caches before any load)
 from . import coupling, interaction
 from .control import modal_gains
+from .initial import InitialArrays, build
 from .model import state_matrices, zero_order_hold
 from .neighbors import all_pairs, arrange, nearest_image, spatial_order, verlet_pairs
 from .scenario import Scenario
-from .setup import Setup, build
 
 #: Command kinds in the compiled loop.
 UNCOUPLE, COUPLE, REMOVE, ADD = range(4)
@@ -92,7 +92,7 @@ class Trajectory:
     Attributes
     ----------
     scenario : Scenario
-    setup : Setup
+    initial : InitialArrays
         The initial arrays: states, flying agents, pairs with their ``d_t`` and
         directions, the periodic box.
     gains : ndarray, shape (4,)
@@ -126,7 +126,7 @@ class Trajectory:
     """
 
     scenario: Scenario
-    setup: Setup
+    initial: InitialArrays
     gains: np.ndarray
     time: np.ndarray
     agents: np.ndarray
@@ -146,12 +146,12 @@ class Trajectory:
     @property
     def pairs(self) -> np.ndarray:
         """The pairs handled one by one (:meth:`Scenario.pairs`), shape (n_pairs, 2)."""
-        return self.setup.edges
+        return self.initial.edges
 
     @property
     def d_t(self) -> np.ndarray:
         """Set distance of each pair, shape (n_pairs,)."""
-        return self.setup.d_t
+        return self.initial.d_t
 
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
@@ -455,7 +455,7 @@ def simulate(
     a, b = state_matrices(m.kp, m.kd, m.g)
     ad, bd = zero_order_hold(a, b, sim.dt)
     gains = modal_gains(m.kp, m.kd, m.g, c.r_l, c.im_l, c.im_r)
-    setup: Setup = build(scenario)
+    setup: InitialArrays = build(scenario)
 
     n_agents, n_axes, _ = setup.state.shape
     # The loop keeps agent order[s] in slot s: a spatial order, with neighbours close in memory.
@@ -569,7 +569,7 @@ def simulate(
     min_neighbor = float(np.sqrt(closest[0]))
     return Trajectory(
         scenario=scenario,
-        setup=setup,
+        initial=setup,
         gains=gains,
         time=steps * sim.dt,
         agents=rec_agents,

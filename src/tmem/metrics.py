@@ -124,14 +124,14 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
 
 def direction_error_deg(trajectory: Trajectory) -> float | None:
     """Largest angle (degrees) between a recorded pair's direction and the one it must hold."""
-    direction = trajectory.setup.direction
+    direction = trajectory.initial.direction
     position = {int(a): q for q, a in enumerate(trajectory.agents)}
     worst = None
     for p, (i, j) in enumerate(trajectory.pairs.tolist()):
         if np.isnan(direction[p, 0]) or i not in position or j not in position:
             continue
         delta = trajectory.state[:, position[j], :, 0] - trajectory.state[:, position[i], :, 0]
-        box = trajectory.setup.box
+        box = trajectory.initial.box
         delta = np.where(box > 0, delta - box * np.round(delta / np.where(box > 0, box, 1.0)), delta)
         cosine = (delta @ direction[p]) / np.linalg.norm(delta, axis=1)
         angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))[trajectory.flag[:, p] == 1]
@@ -162,10 +162,10 @@ def summarize(trajectory: Trajectory) -> dict:
     """
     scenario = trajectory.scenario
     rms = [
-        rms_velocity(trajectory.setup.state[..., 1], trajectory.setup.active),
+        rms_velocity(trajectory.initial.state[..., 1], trajectory.initial.active),
         rms_velocity(trajectory.final_state[..., 1], trajectory.final_active),
     ]
-    box = trajectory.setup.box
+    box = trajectory.initial.box
     min_pairs = float(trajectory.min_distance.min()) if len(trajectory.min_distance) else np.inf
     min_distance = min(min_pairs, trajectory.min_neighbor_distance)
     return {

@@ -48,9 +48,9 @@ from scipy.optimize import brentq
 from . import interaction
 from .control import interaction_point, modal_gains
 from .engine import record_steps
+from .initial import build
 from .model import state_matrices
 from .scenario import Scenario
-from .setup import build
 
 #: Modes of a pair: ``|d| > reach``, ``|d| < reach``, or sliding on ``|d| = reach``.
 OUTSIDE, INSIDE, SLIDING = 0, 1, 2

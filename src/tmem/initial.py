@@ -18,7 +18,7 @@ from .scenario import Scenario
 
 
 @dataclass(frozen=True)
-class Setup:
+class InitialArrays:
     """Initial arrays of a run.
 
     Attributes
@@ -81,7 +81,7 @@ def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
     return state[np.lexsort(cells.T)]
 
 
-def build(scenario: Scenario) -> Setup:
+def build(scenario: Scenario) -> InitialArrays:
     """The initial arrays of ``scenario``."""
     axes = scenario.space.axes
     n = scenario.n_agents
@@ -116,4 +116,4 @@ def build(scenario: Scenario) -> Setup:
     box = np.asarray(scenario.space.box, dtype=float) if scenario.space.periodic else np.zeros(axes)
     if scenario.space.periodic:
         state[:, :, 0] %= box
-    return Setup(state, active, edges, d_ts, direction, flag, box)
+    return InitialArrays(state, active, edges, d_ts, direction, flag, box)
