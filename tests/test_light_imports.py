@@ -1,4 +1,4 @@
-"""What loads what: validating a scenario stays free of Numba.
+"""What loads what: validation and the command line's help stay free of Numba, xarray and matplotlib.
 
 Checked as modules present after an import, in a fresh interpreter; how fast a
 start is belongs to benchmarks, not to tests.
@@ -34,6 +34,16 @@ def test_loading_a_file_and_editing_it_loads_no_numba():
         "s.with_changes(s.loads(text), {'interaction.function': 'repulsion'})"
     )
     assert "numba" not in loaded_after(code)
+
+
+def test_the_command_line_module_loads_nothing_heavy():
+    assert loaded_after("import tmem.cli") == set()
+
+
+@pytest.mark.parametrize("args", [["--help"], ["run", "--help"], ["sweep", "--help"]])
+def test_help_works_and_loads_nothing_heavy(args):
+    code = f"import sys; sys.argv = ['tmem', *{args!r}]\nfrom tmem.cli import main\ntry:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code"
+    assert loaded_after(code) == set()
 
 
 def test_the_package_names_load_on_first_use():
