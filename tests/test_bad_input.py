@@ -58,9 +58,12 @@ CASES = {
     "pair of three": (edit("pair = [0, 1]", "pair = [0, 1, 1]"), "commands[0].pair", "at most 2"),
     "bearing on one axis": (GOOD + '\n[formation]\nkind = "edges"\nedges = [[0, 1]]\nbearing = true\n',
                             "formation.bearing", "2 or 3 axes"),
-    "table as a number": (GOOD.replace("[model]\nkp = 6.0\nkd = 25.0\ng = 9.8", "model = 3"), "model", "must be a table"),
+    "table as a number": (GOOD.replace('[model]\nkind = "linear"\nkp = 6.0\nkd = 25.0\ng = 9.8', "model = 3"), "model", "must be a table"),
+    "unknown model kind": (edit('kind = "linear"', 'kind = "nonsense"'), "model.kind", "must be 'linear', got 'nonsense'"),
+    "model kind not a name": (edit('kind = "linear"', "kind = 2"), "model.kind", "must be 'linear', got 2"),
+    "typo in a model key": (edit("kd = 25.0", "kdd = 25.0"), "model.kdd", "unknown key"),
     "wrong type": (edit("kd = 25.0", 'kd = "fast"'), "model.kd", "number"),
-    "toml syntax": (edit("kd = 25.0", "kd = = 25.0"), "TOML syntax error", "line 5"),
+    "toml syntax": (edit("kd = 25.0", "kd = = 25.0"), "TOML syntax error", "line 6"),
 }
 
 

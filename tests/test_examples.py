@@ -42,3 +42,12 @@ def test_scenario_survives_its_own_toml(path):
 def test_awkward_names_survive_toml():
     scenario = with_changes(tmem.preset("fig9"), {"name": 'two\nlines, "quotes", \\ é 😀 \x7f'})
     assert tmem.loads(scenario.to_toml()) == scenario
+
+
+def test_model_without_kind_is_the_linear_model():
+    """Files written before ``[model] kind`` existed load as the linear model they meant."""
+    text = tmem.preset("fig9").to_toml()
+    assert '[model]\nkind = "linear"\n' in text
+    older = text.replace('kind = "linear"\n', "", 1)
+    assert tmem.loads(older) == tmem.preset("fig9")
+    assert tmem.loads(older).model.kind == "linear"

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from . import coupling
+from . import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
 from .control import corrected_position, gains_for
 from .engine.driver import law_of
 from .interaction.kernels import pair_control

@@ -3,6 +3,10 @@
 User mistakes (a bad scenario, an unusable output directory) end with one
 line on standard error naming the field and the reason, exit status 2 and no
 output written.
+
+Each command imports what it needs (the compiled engine, xarray, matplotlib,
+Dask) in its body, so that ``tmem --help`` and a mistyped command answer at
+once.
 """
 
 from __future__ import annotations
@@ -16,10 +20,6 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
-
-from .engine import SimulationError, simulate
-from .io import OutputError, check_output_directory, write_run
-from .scenario import ScenarioError, load
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__.split("\n")[0])
 console = Console(stderr=True)
@@ -80,6 +80,10 @@ def run(
     out: Path = typer.Option(..., "--out", "-o", help="Output directory (replaced if it holds an earlier run)."),
 ) -> None:
     """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT."""
+    from .engine import SimulationError, simulate
+    from .io import OutputError, check_output_directory, write_run
+    from .scenario import ScenarioError, load
+
     progress = _LazyProgress()
     try:
         loaded = load(scenario)
@@ -99,6 +103,8 @@ def paper(
     out: Path = typer.Option(Path("out/paper"), "--out", "-o", help="Output directory."),
 ) -> None:
     """Reproduce the paper's Figs. 5, 7 and 9 into OUT/fig5, OUT/fig7, OUT/fig9 and OUT/report.md."""
+    from .engine import SimulationError
+    from .io import OutputError
     from .paper import run_paper
 
     progress = _LazyProgress()
@@ -137,6 +143,7 @@ def sweep_command(
     workers: int = typer.Option(None, min=1, help="Worker processes of the local cluster; default: one per core."),
 ) -> None:
     """Run every case of SWEEP_FILE on Dask; write results.parquet, summary.md and figures to OUT."""
+    from .io import OutputError
     from .sweep import SweepError, SweepInterrupted, load_sweep, run_sweep
 
     try:

@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import numba
 
+from . import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+
 #: Command actions, in the order of their integer codes.
 ACTIONS = ("uncouple", "couple")
 #: Event kinds, in the order of their integer codes.

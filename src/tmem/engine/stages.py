@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import coupling
+from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
 from ..control import corrected_position
 from ..interaction.kernels import FunctionParams, pair_control
 from ..neighbors import nearest_image

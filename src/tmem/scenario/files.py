@@ -1,0 +1,172 @@
+"""Scenario files: TOML reading and writing, editing by parameter path, and the shipped presets.
+
+:func:`load` and :func:`loads` read a scenario, :func:`with_changes` edits one,
+:func:`preset` gives one of the paper's, :meth:`Scenario.to_toml` writes one
+back.  Every failure is a :class:`ScenarioError` with one line naming the
+field and the reason (:func:`describe`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from .schema import Scenario
+from .tables import MODEL_KINDS, FieldError, ScenarioError
+
+#: The shipped scenarios, ``src/tmem/presets/NAME.toml``.
+PRESETS = ("fig5", "fig7", "fig9", "repulsion")
+
+
+#: Tables chosen by a kind: pydantic names the kind in a location (``model.linear.kp``); a file does not.
+_KINDS = {"model": MODEL_KINDS}
+
+
+def _location(loc: tuple) -> str:
+    if len(loc) > 1 and loc[1] in _KINDS.get(loc[0], ()):
+        loc = loc[:1] + loc[2:]
+    text = ""
+    for part in loc:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text
+
+
+_REWORDING = (
+    ("Input should be a valid dictionary or instance of", "must be a table, a"),
+    ("Input should be a valid dictionary or object to extract fields from", "must be a table"),
+    ("List should have", "must have"),
+    ("Input should be", "must be"),
+    (" after validation", ""),
+)
+
+
+def _explain(error: dict) -> str:
+    where = _location(error["loc"])
+    kind = error["type"]
+    if kind == "extra_forbidden":
+        reason = "unknown key (a typo?)"
+    elif kind == "missing":
+        reason = "is required"
+    elif kind == "finite_number":
+        reason = f"must be a finite number, got {error['input']}"
+    elif kind == "union_tag_invalid":  # a table chosen by kind, of an unknown kind
+        key = error["ctx"]["discriminator"].strip("'")
+        where, tags = f"{where}.{key}", error["ctx"]["expected_tags"]
+        reason = f"must be {'one of ' if ',' in tags else ''}{tags}, got {error['input'][key]!r}"
+    else:
+        ctx_error = error.get("ctx", {}).get("error")
+        if isinstance(ctx_error, FieldError):
+            where = f"{where}.{ctx_error.field}" if where and ctx_error.field else (where or ctx_error.field)
+            reason = ctx_error.reason
+        else:
+            reason = error["msg"].removeprefix("Value error, ")
+            for pydantic_words, ours in _REWORDING:
+                reason = reason.replace(pydantic_words, ours)
+            if "got" not in reason and "input" in error and not isinstance(error["input"], dict | list):
+                reason += f", got {error['input']!r}"
+    return f"{where}: {reason}" if where else reason
+
+
+def describe(exc: ValidationError) -> str:
+    """A validation failure as one line: each error's field and reason, in the file's words."""
+    return "; ".join(_explain(e) for e in exc.errors())
+
+
+def from_dict(data: dict) -> Scenario:
+    """Validate a scenario given as nested dicts; raise :class:`ScenarioError`."""
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise ScenarioError(describe(exc)) from None
+
+
+def read_text(path: Path, what: str, error: type[ValueError]) -> str:
+    """The text of the ``what`` file at ``path``; a missing or unreadable file raises ``error`` in one line."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise error(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise error(f"{path}: is a directory, not a {what} file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise error(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
+
+
+def load(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file; raise :class:`ScenarioError`."""
+    path = Path(path)
+    return loads(read_text(path, "scenario", ScenarioError), source=str(path))
+
+
+def loads(text: str, source: str = "<scenario>") -> Scenario:
+    """Parse and validate scenario TOML text; raise :class:`ScenarioError`."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{source}: TOML syntax error: {exc}") from None
+    try:
+        return from_dict(data)
+    except ScenarioError as exc:
+        raise ScenarioError(f"{source}: {exc}") from None
+
+
+def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
+    """A copy of ``scenario`` with values replaced by dotted path, validated again.
+
+    Example: ``with_changes(s, {"interaction.function": "repulsion", "agents[1].velocity": 2.0})``.
+    A whole list can be replaced too: ``{"agents": [{"position": 0.0}, {"position": 50.0}]}``.
+    """
+    data = scenario.model_dump()
+    for path, value in changes.items():
+        parts = [int(p) if p.isdigit() else p for p in path.replace("[", ".").replace("]", "").split(".")]
+        node = data
+        try:
+            for part in parts[:-1]:
+                node = node[part]
+            if isinstance(node, dict) and parts[-1] not in node:
+                raise KeyError(parts[-1])
+            node[parts[-1]] = value
+        except (KeyError, IndexError, TypeError):
+            raise ScenarioError(f"{path}: unknown parameter path") from None
+    return from_dict(data)
+
+
+def preset(name: str) -> Scenario:
+    """One of the shipped scenarios: the paper's ``fig5``, ``fig7``, ``fig9`` or ``repulsion``."""
+    if name not in PRESETS:
+        raise ScenarioError(f"preset: unknown name {name!r}; choose from {', '.join(PRESETS)}")
+    text = resources.files("tmem").joinpath("presets", f"{name}.toml").read_text(encoding="utf-8")
+    return loads(text, source=f"preset {name}")
+
+
+def _to_toml(data: dict) -> str:
+    lines: list[str] = []
+    scalars = {k: v for k, v in data.items() if not isinstance(v, dict | list)}
+    lines += [f"{k} = {_toml_value(v)}" for k, v in scalars.items()]
+    for key, value in data.items():
+        if isinstance(value, dict):
+            lines += ["", f"[{key}]"] + [f"{k} = {_toml_value(v)}" for k, v in value.items()]
+        elif isinstance(value, list):
+            for item in value:
+                lines += ["", f"[[{key}]]"]
+                lines += [f"{k} = {_toml_value(v)}" for k, v in item.items() if v is not None]
+    return "\n".join(lines).lstrip() + "\n"
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        # A JSON string is a TOML basic string, given raw non-ASCII text and an escaped DEL.
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007F")
+    if isinstance(v, float):
+        return repr(v) if math.isfinite(v) else str(v)
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return str(v)

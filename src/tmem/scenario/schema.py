@@ -1,0 +1,226 @@
+"""The scenario schema: the whole scenario, its tables checked against each other.
+
+A scenario is a TOML file with the tables ``[model]`` (Table 1),
+``[controller]`` (roots (5)), ``[interaction]``, ``[simulation]``,
+``[[agents]]`` (Table 2) and ``[[commands]]``, and optionally ``[space]``,
+``[neighbors]``, ``[formation]`` and ``[swarm]`` (:mod:`tmem.scenario.tables`).
+Every key is checked: unknown keys, non-finite numbers and values out of range
+are refused; :func:`tmem.scenario.files.describe` turns the errors into the one
+line of a :class:`ScenarioError`.  Defaults are documented in
+``docs/parameters.md``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydantic import model_validator
+
+from ..formation import generate
+from ..interaction.registry import uses_coupling
+from .tables import (
+    Agent,
+    Command,
+    ControllerParams,
+    FieldError,
+    FormationParams,
+    InteractionParams,
+    LinearModelParams,
+    ModelParams,
+    NeighborParams,
+    SimulationParams,
+    SpaceParams,
+    StrictModel,
+    SwarmParams,
+)
+
+#: Most bytes a run may set aside for its records.
+MAX_RECORD_BYTES = 8 * 2**30
+#: Beyond this many agents, a coupling function needs a [formation]: without one every pair
+#: would be a formation pair, and their number grows as the square of the swarm.
+MAX_AGENTS_ALL_PAIRS = 2000
+#: Without a formation, swarms up to this size have every pair tracked (recorded distances,
+#: per-pair figures) even when the function has no coupling flag.
+TRACK_ALL_PAIRS = 32
+
+
+class Scenario(StrictModel):
+    """A whole scenario; see the module docstring.
+
+    The agents come from exactly one of ``[[agents]]`` (Table 2),
+    ``[formation]`` with a generated ``kind`` (chain, ring, triangle, hex) or
+    ``[swarm]`` (random); ``[formation] kind = "edges"`` couples listed
+    ``[[agents]]``.  Without a formation, a coupling function (10) or (11)
+    treats every pair as a formation pair with the set distance
+    ``interaction.d_t``: the paper's two-agent case.
+    """
+
+    name: str = ""
+    model: ModelParams = LinearModelParams()
+    controller: ControllerParams = ControllerParams()
+    interaction: InteractionParams = InteractionParams()
+    simulation: SimulationParams = SimulationParams()
+    space: SpaceParams = SpaceParams()
+    neighbors: NeighborParams = NeighborParams()
+    formation: FormationParams | None = None
+    swarm: SwarmParams | None = None
+    agents: list[Agent] = []
+    commands: list[Command] = []
+
+    @property
+    def n_agents(self) -> int:
+        if self.swarm is not None:
+            return self.swarm.n
+        if self.formation is not None and self.formation.kind != "edges":
+            return 3 if self.formation.kind == "triangle" else self.formation.n
+        return len(self.agents)
+
+    def pairs(self) -> np.ndarray:
+        """The pairs handled one by one, ``(i, j)`` with ``i < j``, shape ``(m, 2)``.
+
+        The formation's edges; without a formation, every pair when the function
+        couples (the paper's case) or the swarm is small (at most
+        :data:`TRACK_ALL_PAIRS` agents), else none.  These pairs carry the flag
+        ``F_en`` and a distance record; all other neighbours only repel.
+        """
+        if self.formation is None:
+            n = self.n_agents
+            if not uses_coupling(self.interaction.function) and n > TRACK_ALL_PAIRS:
+                return np.empty((0, 2), dtype=np.int64)
+            i, j = np.triu_indices(n, k=1)
+            return np.stack([i, j], axis=1).astype(np.int64)
+        if self.formation.kind == "edges":
+            return np.array(sorted(sorted(e[:2]) for e in self.formation.edges), dtype=np.int64).reshape(-1, 2)
+        f = self.formation
+        return generate(f.kind, self.n_agents, f.d_t or self.interaction.d_t, self.space.axes).edges
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "Scenario":
+        axes = self.space.axes
+        self._check_sources()
+        self._check_agents(axes)
+        n = self.n_agents
+        if n < 2:
+            raise FieldError("agents", f"needs at least 2 agents, got {n}")
+        if self.formation is not None:
+            self._check_formation(axes, n)
+        elif uses_coupling(self.interaction.function) and n > MAX_AGENTS_ALL_PAIRS:
+            raise FieldError(
+                "interaction.function",
+                f"{self.interaction.function!r} without a [formation] makes all {n * (n - 1) // 2} pairs "
+                f"formation pairs; give a [formation] or use 'repulsion' beyond {MAX_AGENTS_ALL_PAIRS} agents",
+            )
+        if self.swarm is not None:
+            region = self.swarm.region or self.space.box
+            if region is None:
+                raise FieldError("swarm.region", "is required unless space.box is given")
+            if len(region) != axes:
+                raise FieldError("swarm.region", f"needs {axes} values (one per axis), got {len(region)}")
+        if self.simulation.record_agents is not None:
+            for k, a in enumerate(self.simulation.record_agents):
+                if not 0 <= a < n:
+                    raise FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
+        pairs = self.pairs()  # generating a large formation is not free: once per validation
+        self._check_commands(n, pairs)
+        self._check_record_size(n, len(pairs))
+        return self
+
+    def _check_record_size(self, n: int, pairs: int) -> None:
+        sim = self.simulation
+        records = sim.n_steps // sim.record_every + 2
+        agents = n if sim.record_agents is None else len(sim.record_agents)
+        size = records * (agents * (5 * self.space.axes * 8 + 1) + pairs * 32)
+        if size > MAX_RECORD_BYTES:
+            raise FieldError(
+                "simulation.record_every",
+                f"the records would take {size / 2**30:.1f} GiB (at most {MAX_RECORD_BYTES / 2**30:g}); "
+                "record less often or fewer agents (record_agents)",
+            )
+
+    def _check_sources(self) -> None:
+        generated = self.formation is not None and self.formation.kind != "edges"
+        sources = [name for name, given in (("agents", bool(self.agents)), ("formation", generated),
+                                            ("swarm", self.swarm is not None)) if given]  # fmt: skip
+        if len(sources) > 1:
+            raise FieldError(sources[1], f"give the agents once: by {' or '.join(sources)}, not both")
+        if not sources:
+            raise FieldError("agents", "no agents: give [[agents]], a [formation] or a [swarm]")
+
+    def _check_agents(self, axes: int) -> None:
+        seen: dict[tuple, int] = {}
+        for k, agent in enumerate(self.agents):
+            place = tuple(np.ravel(agent.position).tolist())
+            if place in seen:
+                raise FieldError(
+                    f"agents[{k}].position",
+                    f"is the place of agents[{seen[place]}]: two agents at one point have no direction to part in",
+                )
+            seen[place] = k
+            for name in ("position", "velocity", "tilt", "tilt_rate"):
+                value = getattr(agent, name)
+                if isinstance(value, list) and len(value) != axes:
+                    raise FieldError(f"agents[{k}].{name}", f"needs {axes} values (one per axis), got {len(value)}")
+                if not isinstance(value, list) and axes > 1 and (name == "position" or value != 0.0):
+                    raise FieldError(f"agents[{k}].{name}", f"needs a list of {axes} values for axes = {axes}")
+
+    def _check_formation(self, axes: int, n: int) -> None:
+        f = self.formation
+        if not uses_coupling(self.interaction.function):
+            raise FieldError("formation", "needs interaction.function 'switching' (10) or 'improved' (11)")
+        if f.bearing and axes == 1:
+            raise FieldError("formation.bearing", "a direction to hold needs 2 or 3 axes, got axes = 1")
+        if f.kind in ("ring", "triangle", "hex") and axes == 1:
+            raise FieldError("formation.kind", f"{f.kind!r} is planar and needs 2 or 3 axes, got axes = 1")
+        d_t = f.d_t or self.interaction.d_t
+        if d_t >= self.interaction.reach:
+            raise FieldError("formation.d_t", f"must be less than R + R_j = {self.interaction.reach:g} m, got {d_t:g}")
+        for name in ("center", "velocity"):
+            value = getattr(f, name)
+            if value is not None and len(value) != axes:
+                raise FieldError(f"formation.{name}", f"needs {axes} values (one per axis), got {len(value)}")
+        if f.kind == "edges":
+            seen = set()
+            for k, edge in enumerate(f.edges):
+                i, j = edge[:2]
+                if not (isinstance(i, int) and isinstance(j, int)):
+                    raise FieldError(f"formation.edges[{k}]", f"needs two agent indices first, got {list(edge)}")
+                if len(edge) == 3 and not 0 < edge[2]:
+                    raise FieldError(f"formation.edges[{k}]", f"d_t must be > 0, got {edge[2]}")
+                if not (0 <= i < n and 0 <= j < n) or i == j:
+                    raise FieldError(f"formation.edges[{k}]", f"needs two different agents in 0..{n - 1}, got {list(edge)}")
+                if len(edge) == 3 and edge[2] >= self.interaction.reach:
+                    raise FieldError(f"formation.edges[{k}]", f"d_t must be less than R + R_j = {self.interaction.reach:g} m")
+                if (min(i, j), max(i, j)) in seen:
+                    raise FieldError(f"formation.edges[{k}]", f"repeats the pair {sorted((i, j))}")
+                seen.add((min(i, j), max(i, j)))
+
+    def _check_commands(self, n: int, formation_pairs: np.ndarray) -> None:
+        pairs = {tuple(e) for e in formation_pairs.tolist()} if self.commands else set()
+        active = [a.active for a in self.agents] if self.agents else [True] * n
+        for k, command in sorted(enumerate(self.commands), key=lambda kc: kc[1].time):
+            where = f"commands[{k}]"
+            if command.time > self.simulation.duration:
+                raise FieldError(
+                    f"{where}.time", f"must not be later than duration = {self.simulation.duration:g} s, got {command.time:g}"
+                )
+            if command.agent is not None:
+                if not 0 <= command.agent < n:
+                    raise FieldError(f"{where}.agent", f"names agent {command.agent}, outside 0..{n - 1}")
+                wanted = command.action == "remove"
+                if active[command.agent] != wanted:
+                    state = "not flying" if wanted else "already flying"
+                    raise FieldError(f"{where}.agent", f"cannot {command.action} agent {command.agent}: it is {state} then")
+                active[command.agent] = not wanted
+            field = f"{where}.pair" if command.pair is not None else f"{where}.pairs"
+            for i, j in command.targets or []:
+                if not (0 <= i < n and 0 <= j < n):
+                    raise FieldError(field, f"names agent outside 0..{n - 1}: {[i, j]}")
+                if i == j:
+                    raise FieldError(field, f"needs two different agents, got {[i, j]}")
+                if (min(i, j), max(i, j)) not in pairs:
+                    raise FieldError(field, f"{[i, j]} is not a formation pair")
+
+    def to_toml(self) -> str:
+        """The scenario as TOML text, every default written out."""
+        from .files import _to_toml  # the writer lives with the reader
+
+        return _to_toml(self.model_dump(mode="json", exclude_none=True))

@@ -1,0 +1,251 @@
+"""The tables of a scenario file, one validated pydantic model each, and their number types.
+
+``[model]`` (Table 1), ``[controller]`` (roots (5)), ``[interaction]`` (7)-(11),
+``[simulation]``, ``[space]``, ``[neighbors]``, ``[formation]``, ``[swarm]``,
+``[[agents]]`` (Table 2) and ``[[commands]]``.  Each table checks its own keys;
+:mod:`tmem.scenario.schema` checks them against each other.  A check that
+spans fields raises :class:`FieldError` naming the field at fault.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
+
+from ..interaction.registry import FUNCTION_NAMES
+from ..model import MODELS
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be run; the message is one line naming the field."""
+
+
+class FieldError(ValueError):
+    """Raised by a cross-field check to name the field at fault, relative to its table."""
+
+    def __init__(self, field: str, reason: str):
+        super().__init__(reason)
+        self.field = field
+        self.reason = reason
+
+
+class StrictModel(BaseModel):
+    # strict: no quiet coercion of true to 1 or "6.0" to 6.0.
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+#: Every number is bounded in magnitude, so that no product in the model overflows.
+LIMIT = 1e9
+Number = Annotated[float, Field(ge=-LIMIT, le=LIMIT)]
+Positive = Annotated[float, Field(gt=0, le=LIMIT)]
+NonNegative = Annotated[float, Field(ge=0, le=LIMIT)]
+Pair = Annotated[list[int], Field(min_length=2, max_length=2)]
+
+
+class LinearModelParams(StrictModel):
+    """Quadrocopter model (1)-(2), linear per axis, Table 1: ``[model] kind = "linear"``."""
+
+    kind: Literal["linear"] = "linear"
+    kp: Positive = 6.0
+    kd: Positive = 25.0
+    g: Positive = 9.8
+
+
+def _linear_unless_named(table: object) -> object:
+    """A ``[model]`` table without ``kind`` is the linear model, as before kinds were named."""
+    if isinstance(table, dict) and "kind" not in table:
+        return {"kind": "linear", **table}
+    return table
+
+
+#: The ``[model]`` table: one class per vehicle model, chosen by its ``kind`` (add a class to the
+#: union for a new kind; pydantic then reports an unknown kind as ``model.kind``).
+ModelParams = Annotated[
+    Union[LinearModelParams],  # noqa: UP007  (one kind so far; `X | Y` needs two)
+    BeforeValidator(_linear_unless_named),
+    Field(discriminator="kind"),
+]
+#: The model kinds a scenario may name (the vehicle-model registry; it loads no compiled code).
+MODEL_KINDS: tuple[str, ...] = tuple(MODELS)
+
+
+class ControllerParams(StrictModel):
+    """Roots (5) of the modal controller, Table 1."""
+
+    r_l: Number = 12.0
+    im_l: NonNegative = 0.1
+    im_r: Positive = 0.55
+
+    @field_validator("r_l")
+    @classmethod
+    def _stable_left_pair(cls, v: float) -> float:
+        if v <= 0:
+            raise ValueError("must be > 0 so that the left pair of roots -r_l +- i im_l is stable")
+        return v
+
+
+class InteractionParams(StrictModel):
+    """Interaction function and its parameters, (7)-(11)."""
+
+    function: Literal[FUNCTION_NAMES] = "improved"
+    radius: Positive = 20.0
+    c_max: Positive = 0.1
+    d_t: Positive = 35.0
+    eps: Positive = 0.2
+    switch_at: Literal["window", "crossing"] = "window"
+
+    @property
+    def reach(self) -> float:
+        """``R + R_j``: the distance below which two agents interact."""
+        return 2.0 * self.radius
+
+    @model_validator(mode="after")
+    def _coupling_inside_reach(self) -> "InteractionParams":
+        if self.d_t >= self.reach:
+            raise FieldError("d_t", f"must be less than R + R_j = {self.reach:g} m (condition (9)), got {self.d_t:g}")
+        if self.eps >= self.d_t:
+            raise FieldError("eps", f"must be less than d_t = {self.d_t:g} m, got {self.eps:g}")
+        return self
+
+
+class SimulationParams(StrictModel):
+    """Time stepping and recording (``record_agents``: the agents recorded; all by default)."""
+
+    dt: Annotated[float, Field(ge=1e-9, le=LIMIT)] = 1e-4
+    duration: Positive = 60.0
+    record_every: Annotated[int, Field(ge=1)] = 100
+    record_agents: list[int] | None = None
+
+    @property
+    def n_steps(self) -> int:
+        """Steps of ``dt`` in ``duration``."""
+        return self.step_of(self.duration)
+
+    def step_of(self, time: float) -> int:
+        """The step at which something due at ``time`` (s) happens: the nearest whole step."""
+        return int(round(time / self.dt))
+
+    @model_validator(mode="after")
+    def _whole_steps(self) -> "SimulationParams":
+        if self.dt > self.duration:
+            raise FieldError("dt", f"must not exceed duration = {self.duration:g} s, got {self.dt:g}")
+        steps = self.duration / self.dt
+        if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
+            raise FieldError("duration", f"must be a whole number of steps dt = {self.dt:g} s, got {self.duration:g}")
+        return self
+
+
+class SpaceParams(StrictModel):
+    """The space the agents fly in: 1 to 3 axes, optionally a periodic box."""
+
+    axes: Literal[1, 2, 3] = 1
+    periodic: bool = False
+    box: list[Positive] | None = None
+
+    @model_validator(mode="after")
+    def _box_fits(self) -> "SpaceParams":
+        if self.box is not None and len(self.box) != self.axes:
+            raise FieldError("box", f"needs {self.axes} values (one per axis), got {len(self.box)}")
+        if self.periodic and self.box is None:
+            raise FieldError("box", "is required when periodic = true")
+        return self
+
+
+class NeighborParams(StrictModel):
+    """Neighbour search: every pair, or Verlet lists built from cells with a skin."""
+
+    method: Literal["auto", "all", "verlet"] = "auto"
+    skin: Positive = 4.0
+
+
+class FormationParams(StrictModel):
+    """A formation: a generated shape, or edges among the ``[[agents]]``."""
+
+    kind: Literal["chain", "ring", "triangle", "hex", "edges"]
+    n: Annotated[int, Field(ge=2)] | None = None
+    d_t: Positive | None = None
+    bearing: bool = False
+    edges: list[Annotated[list[int | float], Field(min_length=2, max_length=3)]] | None = None
+    center: list[Number] | None = None
+    velocity: list[Number] | None = None
+    jitter: NonNegative = 0.0
+    seed: int = 0
+    coupled: bool = True
+
+    @model_validator(mode="after")
+    def _kind_needs(self) -> "FormationParams":
+        if self.kind == "edges":
+            if not self.edges:
+                raise FieldError("edges", 'is required (and not empty) for kind = "edges"')
+            for name in ("n", "center", "velocity"):
+                if getattr(self, name) is not None:
+                    raise FieldError(name, 'is not used with kind = "edges": give the [[agents]]')
+        else:
+            if self.edges is not None:
+                raise FieldError("edges", f'is only for kind = "edges", not {self.kind!r}')
+            if self.kind == "triangle" and self.n not in (None, 3):
+                raise FieldError("n", f"a triangle has 3 agents, got {self.n}")
+            if self.kind in ("chain", "ring", "hex") and self.n is None:
+                raise FieldError("n", f"is required for kind = {self.kind!r}")
+            if self.kind == "ring" and self.n is not None and self.n < 3:
+                raise FieldError("n", f"a ring needs at least 3 agents, got {self.n}")
+        return self
+
+
+class SwarmParams(StrictModel):
+    """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``."""
+
+    n: Annotated[int, Field(ge=2)]
+    seed: int = 0
+    region: list[Positive] | None = None
+    speed_rms: NonNegative = 0.0
+
+
+Vector = Number | list[Number]
+
+
+class Agent(StrictModel):
+    """Initial state of one agent (Table 2): a number per axis, or one number on one axis."""
+
+    position: Vector
+    velocity: Vector = 0.0
+    tilt: Vector = 0.0
+    tilt_rate: Vector = 0.0
+    active: bool = True
+
+
+class Command(StrictModel):
+    """An operator's command at ``time``.
+
+    ``couple`` / ``uncouple`` act on ``pair``, on the listed ``pairs``, or on
+    every formation pair when neither is given; ``remove`` / ``add`` act on
+    ``agent``.
+    """
+
+    time: NonNegative
+    action: Literal["couple", "uncouple", "remove", "add"]
+    pair: Pair | None = None
+    pairs: list[Pair] | None = None
+    agent: int | None = None
+
+    @model_validator(mode="after")
+    def _targets(self) -> "Command":
+        if self.action in ("couple", "uncouple"):
+            if self.agent is not None:
+                raise FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
+            if self.pair is not None and self.pairs is not None:
+                raise FieldError("pairs", "give pair or pairs, not both")
+        else:
+            if self.agent is None:
+                raise FieldError("agent", f"is required for {self.action}")
+            if self.pair is not None or self.pairs is not None:
+                raise FieldError("pair", f"is for couple / uncouple, not {self.action}")
+        return self
+
+    @property
+    def targets(self) -> list[list[int]] | None:
+        """The pairs a couple / uncouple command names; ``None`` for every pair."""
+        if self.pair is not None:
+            return [self.pair]
+        return self.pairs
