@@ -40,6 +40,45 @@ EXTENSIONS = {
                 ),
             )  # fmt: skip''')),
     ],
+    "vehicle model": [
+        ("model/drag.py", "", textwrap.dedent('''\
+            """A toy vehicle: the linear model (2) with drag on the velocity, V' = g phi - c_d V."""
+
+            from .base import VehicleModel
+            from .linear import STATE_NAMES, HoldStep, state_matrices, step_zero_order_hold, zero_order_hold
+
+
+            class DragModel(VehicleModel):
+                kind = "drag"
+                state_names = STATE_NAMES
+                state_units = ("m", "m s-1", "rad", "rad s-1")
+                long_names = ("position", "velocity", "tilt from the vertical", "tilt rate")
+                step = step_zero_order_hold
+
+                def linearisation(self):
+                    a, b = state_matrices(self.params.kp, self.params.kd, self.params.g)
+                    a[1, 1] = -self.params.c_d
+                    return a, b
+
+                def step_params(self, dt):
+                    return HoldStep(*zero_order_hold(*self.linearisation(), dt))
+            ''')),
+        ("model/__init__.py", '    "linear": "tmem.model.linear:LinearModel",\n',
+         '    "linear": "tmem.model.linear:LinearModel",\n    "drag": "tmem.model.drag:DragModel",\n'),
+        ("scenario/tables.py", "def _linear_unless_named", textwrap.dedent('''\
+            class DragModelParams(StrictModel):
+                """The linear model with drag: ``[model] kind = "drag"``."""
+
+                kind: Literal["drag"]
+                kp: Positive = 6.0
+                kd: Positive = 25.0
+                g: Positive = 9.8
+                c_d: Positive = 0.5
+
+
+            def _linear_unless_named''')),
+        ("scenario/tables.py", "Union[LinearModelParams]", "Union[LinearModelParams, DragModelParams]"),
+    ],
     "sensing effect": [
         ("sensing.py", 'EFFECTS = ("identity",)', 'EFFECTS = ("identity", "quantised")'),
         ("sensing.py", "    known: np.ndarray\n", "    known: np.ndarray\n    quantum: float = 0.0\n"),
@@ -66,6 +105,9 @@ def extended(tmp_path_factory) -> Path:
     for edits in EXTENSIONS.values():
         for name, old, new in edits:
             path = root / "tmem" / name
+            if not old:  # a new file
+                path.write_text(new)
+                continue
             text = path.read_text()
             assert text.count(old) == 1, (name, old)
             path.write_text(text.replace(old, new))
@@ -109,6 +151,31 @@ def test_a_new_interaction_function_is_chosen_by_name_and_run_by_the_loop(extend
     for n in ("2", "80"):
         assert out[n] == pytest.approx([-0.05, 0.05], rel=1e-15)
     assert out["evaluate"] == [0.05, -0.05, 0.0]
+
+
+def test_a_new_vehicle_model_gets_its_gains_placed_and_flies_its_own_dynamics(extended):
+    """The drag model: its gains put the closed loop's roots at (5) (pole placement, since its (A, B)
+    is not the paper's), and an agent far from others, level, decays as V0 exp(-c_d t)."""
+    out = run(extended, '''
+        import json
+        import numpy as np
+        import tmem
+        from tmem.model import vehicle_model
+        from tmem.scenario import from_dict
+        s = from_dict({"model": {"kind": "drag", "c_d": 0.5}, "interaction": {"function": "repulsion"},
+                       "agents": [{"position": 0.0, "velocity": 2.0}, {"position": 5000.0}],
+                       "simulation": {"dt": 0.01, "duration": 4.0, "record_every": 10}})
+        tr = tmem.simulate(s)
+        a, b = vehicle_model(s.model).linearisation()
+        roots = np.linalg.eigvals(a - np.outer(b, tr.gains))
+        print(json.dumps({"t": tr.time.tolist(), "v": tr.state[:, 0, 0, 1].tolist(), "names": list(tr.model.state_names),
+                          "roots": sorted([[r.real, r.imag] for r in roots])}))
+    ''')
+    t = np.array(out["t"])
+    np.testing.assert_allclose(out["v"], 2.0 * np.exp(-0.5 * t), rtol=1e-11)
+    expected = sorted([[-12.0, -0.1], [-12.0, 0.1], [0.0, -0.55], [0.0, 0.55]])
+    np.testing.assert_allclose(out["roots"], expected, atol=1e-6)
+    assert out["names"] == ["P", "V", "phi", "omega"]
 
 
 def test_a_new_sensing_effect_changes_what_the_agents_know(extended):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -152,6 +153,47 @@ def _read_events(events: Events, n_events: int, order: np.ndarray, dt: float) ->
     return found
 
 
+@dataclass
+class _Slots:
+    """A run's records with the agents in slots: ``order[s]`` is the agent in slot ``s``, ``slot[a]``
+    the slot of agent ``a``.  The loop keeps a spatial order, so that neighbours are close in memory."""
+
+    order: np.ndarray
+    slot: np.ndarray
+    agents: Agents
+    pairs: Pairs
+    commands: Commands
+    records: Records
+    events: Events
+    counters: Counters
+    recorded: np.ndarray  # the recorded agents, by number
+    steps: np.ndarray  # the recorded steps
+
+
+def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, record: bool) -> _Slots:
+    """The records of a run, its agents placed in a spatial order of their ``P*`` (6)."""
+    sim = scenario.simulation
+    n_agents, n_axes, n_state = initial.state.shape
+    cell = scenario.interaction.reach + scenario.neighbors.skin
+    order = spatial_order(interaction_point(initial.state, gains), initial.active, cell, initial.box)
+    slot = np.empty(n_agents, dtype=np.int64)
+    slot[order] = np.arange(n_agents)
+    x = initial.state[order]
+    agents = Agents(x, x.copy(), initial.active[order], np.empty((n_agents, n_axes, 2)), np.zeros((n_agents, n_axes)))
+    edges = initial.edges
+    n_edges = len(edges)
+    pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
+                  np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf))  # fmt: skip
+    commands = _commands(scenario, edges, slot)
+    steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
+    recorded = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
+    recorded = recorded if record else recorded[:0]
+    records = _records(len(steps), recorded, slot[recorded], n_axes, n_state, n_edges)
+    # A pair changes flag at most once before any command and twice after each.
+    events = _events(n_edges * (1 + 2 * len(commands.step)) + len(commands.step))
+    return _Slots(order, slot, agents, pairs, commands, records, events, Counters.zero(), recorded, steps)
+
+
 def simulate(
     scenario: Scenario,
     progress: Callable[[int, int], None] | None = None,
@@ -184,76 +226,70 @@ def simulate(
     SimulationError
         If the run diverged.
     """
-    sim = scenario.simulation
+    sim, c = scenario.simulation, scenario.controller
     model = vehicle_model(scenario.model)
-    gains = gains_for(*model.linearisation(), scenario.controller.r_l, scenario.controller.im_l, scenario.controller.im_r)
-    initial: InitialArrays = build(scenario)
-    n_agents, n_axes, n_state = initial.state.shape
-    box = tuple(initial.box.tolist())
-    method = scenario.neighbors.method
-    use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
-    run = Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
+    gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
+    initial = build(scenario)
+    run = _run_of(scenario, initial, record)
     law, params = law_of(scenario, gains)
-    vehicle = model.step_params(sim.dt)
-
-    # The loop keeps agent order[s] in slot s: a spatial order, with neighbours close in memory.
-    order = spatial_order(interaction_point(initial.state, gains), initial.active, run.skin + scenario.interaction.reach, initial.box)
-    slot = np.empty(n_agents, dtype=np.int64)
-    slot[order] = np.arange(n_agents)
-    x = initial.state[order]
-    agents = Agents(x, x.copy(), initial.active[order], np.empty((n_agents, n_axes, 2)), np.zeros((n_agents, n_axes)))
-    edges = initial.edges
-    n_edges = len(edges)
-    pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
-                  np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf))  # fmt: skip
-    commands = _commands(scenario, edges, slot)
-
-    steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
-    rec_agents = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
-    rec_agents = rec_agents if record else rec_agents[:0]
-    records = _records(len(steps), rec_agents, slot[rec_agents], n_axes, n_state, n_edges)
-    # A pair changes flag at most once before any command and twice after each.
-    events = _events(n_edges * (1 + 2 * len(commands.step)) + len(commands.step))
-    counters = Counters.zero()
-
-    lister = _NeighbourLister(scenario, n_agents, n_axes, np.stack([pairs.i, pairs.j], axis=1), use_lists)
+    swarm = _in_slots(scenario, initial, gains, record)
+    x = swarm.agents.state
+    lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], np.stack([swarm.pairs.i, swarm.pairs.j], axis=1), run.use_lists)
     lister.p_ref[:] = interaction_point(x, gains)  # P* (6) at the start
-    neighbours = lister.list(agents.active, box)
-    advance = advance_for(type(model), n_agents >= THREADED_SWARM)
+    advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM)
     sensing = exact(x) if sensing is None else sensing
-    chunk = 1000
-    while counters.step[0] <= sim.n_steps:
-        started = _time.perf_counter()
-        stop = min(counters.step[0] + chunk, sim.n_steps + 1)
-        status = advance(stop, run, law, params, vehicle, sensing, agents, pairs, neighbours, commands, records, events, counters)
-        if status == LISTS_STALE:
-            neighbours = lister.list(agents.active, box)  # and go on from the same step
-            continue
-        elapsed = _time.perf_counter() - started
-        if progress is not None:
-            progress(min(int(counters.step[0]), sim.n_steps), sim.n_steps)
-        # Grow chunks towards about chunk_seconds each (the first includes compilation).
-        chunk = int(min(max(chunk * 4, 1000), max(1000, chunk * chunk_seconds / max(elapsed, 1e-9))))
-
-    if not np.all(np.isfinite(x[agents.active])):
+    _drive(advance, run, law, params, model.step_params(sim.dt), sensing, swarm, lister, progress, chunk_seconds)
+    if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
     return Trajectory(
         scenario=scenario,
         initial=initial,
         model=model,
         gains=gains,
-        time=steps * sim.dt,
-        agents=rec_agents,
-        state=records.state,
-        control=records.control,
-        active=records.active,
-        flag=records.flag,
-        pair_distance=records.distance,
-        interaction_distance=records.measure,
-        min_distance=pairs.min_distance,
+        time=swarm.steps * sim.dt,
+        agents=swarm.recorded,
+        state=swarm.records.state,
+        control=swarm.records.control,
+        active=swarm.records.active,
+        flag=swarm.records.flag,
+        pair_distance=swarm.records.distance,
+        interaction_distance=swarm.records.measure,
+        min_distance=swarm.pairs.min_distance,
         min_neighbor_distance=float(np.sqrt(lister.closest[0])),
-        final_state=x[slot],
-        final_active=agents.active[slot],
-        events=_read_events(events, int(counters.n_events[0]), order, sim.dt),
+        final_state=x[swarm.slot],
+        final_active=swarm.agents.active[swarm.slot],
+        events=_read_events(swarm.events, int(swarm.counters.n_events[0]), swarm.order, sim.dt),
         list_builds=lister.builds,
     )
+
+
+def _run_of(scenario: Scenario, initial: InitialArrays, record: bool) -> Run:
+    """What stays fixed over the run: steps, recording, the box, the kind of neighbour list."""
+    sim = scenario.simulation
+    n_agents = initial.state.shape[0]
+    method = scenario.neighbors.method
+    use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
+    box = tuple(initial.box.tolist())
+    return Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
+
+
+def _drive(advance, run: Run, law: Law, params, vehicle, sensing: Sensing, swarm: _Slots, lister: _NeighbourLister,
+           progress, chunk_seconds: float) -> None:
+    """Run the compiled loop ``advance`` over every step, in chunks of about ``chunk_seconds``,
+    listing the neighbours again whenever the loop asks."""
+    neighbours = lister.list(swarm.agents.active, run.box)
+    counters = swarm.counters
+    chunk = 1000
+    while counters.step[0] <= run.n_steps:
+        started = _time.perf_counter()
+        stop = min(counters.step[0] + chunk, run.n_steps + 1)
+        status = advance(stop, run, law, params, vehicle, sensing, swarm.agents, swarm.pairs, neighbours, swarm.commands,
+                         swarm.records, swarm.events, counters)  # fmt: skip
+        if status == LISTS_STALE:
+            neighbours = lister.list(swarm.agents.active, run.box)  # and go on from the same step
+            continue
+        elapsed = _time.perf_counter() - started
+        if progress is not None:
+            progress(min(int(counters.step[0]), run.n_steps), run.n_steps)
+        # Grow chunks towards about chunk_seconds each (the first includes compilation).
+        chunk = int(min(max(chunk * 4, 1000), max(1000, chunk * chunk_seconds / max(elapsed, 1e-9))))
