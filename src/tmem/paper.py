@@ -79,11 +79,9 @@ def _rms_sentence(ours: float, paper: float) -> str:
     return f"Our RMS change is {abs(diff):.2f} percentage points {'higher' if diff > 0 else 'lower'} than the paper's {paper:g} %."
 
 
-def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> str:
-    """The Markdown report: the paper's stated results beside ours."""
-    scenario = trajectories["fig7"].scenario
+def _header(scenario, gains: list[float]) -> list[str]:
     ia, sim = scenario.interaction, scenario.simulation
-    lines = [
+    return [
         "# tmem: the paper's simulations reproduced",
         "",
         "Paper: E. Heiss, A. Kozyr, O. Morozov, *Formations Organization in Robotic Swarm Using the "
@@ -92,77 +90,120 @@ def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> s
         "",
         f"Parameters the paper does not state (chosen in docs/parameters.md): c_max = {ia.c_max:g} rad, "
         f"d_t = {ia.d_t:g} m, eps = {ia.eps:g} m, dt = {sim.dt:g} s, duration = {sim.duration:g} s. "
-        f"Gains K = ({', '.join(f'{k:.6g}' for k in summaries['fig7']['gains'])}) for (P, V, phi, omega), "
+        f"Gains K = ({', '.join(f'{k:.6g}' for k in gains)}) for (P, V, phi, omega), "
         "from the roots (5) (formula (4) as printed is misprinted; see docs/equations.md).",
         "",
         "| Figure | Function | Quantity | Paper | tmem | Agrees |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
-    notes: list[str] = []
-    reach = ia.reach
-    for name, stated in PAPER.items():
-        s = summaries[name]
-        pair = s["pairs"][0]
-        if stated.function.startswith("attraction"):
-            separated = s["final_distance"] > reach
-            lines.append(
-                f"| {stated.figure} | {stated.function} | coupled | no | "
-                f"{'no' if separated else 'yes'} (final distance {s['final_distance']:.1f} m, "
-                f"R + R_j = {reach:g} m) | {_yes(separated)} |"
-            )
-            lines.append(
-                f"| {stated.figure} | {stated.function} | RMS velocity change | not stated | "
-                f"{s['rms_change_percent']:+.2f} % | — |"
-            )
-            notes.append(
-                f"**{stated.figure}.** The paper shows that attraction alone does not couple the pair. Ours "
-                f"agrees: the agents come as close as {s['min_distance']:.1f} m, are accelerated towards "
-                f"each other on the way in and apart on the way out, and end {s['final_distance']:.1f} m apart, "
-                f"beyond R + R_j. The paper gives no RMS change for this case; ours is "
-                f"{s['rms_change_percent']:+.2f} %."
-            )
-            continue
-        uncoupled = pair["uncoupled_at"]
-        separated = pair["separated_at"]
-        in_time = (
-            uncoupled is not None
-            and COMMAND_TIME < uncoupled < UNCOUPLE_BY
-            and separated is not None
-            and separated > DISCONNECTION_AFTER
-        )
-        lines.append(
-            f"| {stated.figure} | {stated.function} | coupled | yes | {_yes(s['coupled'])} "
-            f"(at {_t(pair['coupled_at'])}) | {_yes(s['coupled'] == stated.coupled)} |"
-        )
-        lines.append(
-            f"| {stated.figure} | {stated.function} | uncoupling | {stated.disconnection} | "
-            f"F_en drops at {_t(uncoupled)}; spheres apart at {_t(pair['separated_at'])} | {_yes(in_time)} |"
-        )
-        rms = s["rms_change_percent"]
-        close = abs(rms - stated.rms_change_percent) <= 0.5 * stated.rms_change_percent
-        lines.append(
-            f"| {stated.figure} | {stated.function} | RMS velocity change | ≈ {stated.rms_change_percent:g} % | "
-            f"{rms:+.2f} % | {'roughly' if close else 'no'} |"
-        )
-        notes.append(
-            f"**{stated.figure}.** The pair couples at {_t(pair['coupled_at'])}, oscillates about "
-            f"{pair['mean_distance_coupled']:.2f} m with an amplitude of {pair['oscillation_amplitude']:.2f} m "
-            f"while coupled, and after the command at {COMMAND_TIME:g} s lets go at {_t(uncoupled)}, the first "
-            f"moment condition (9) holds; the spheres stop intersecting at {_t(pair['separated_at'])}. The paper "
-            f"reports the actual disconnection at {stated.disconnection}: "
-            f"{'consistent' if in_time else 'not consistent'}. " + _rms_sentence(rms, stated.rms_change_percent)
-        )
+
+
+def _attraction(stated, s: dict, reach: float) -> tuple[list[str], str]:
+    """Table rows and note for the paper's Fig. 5: attraction alone does not couple."""
+    separated = s["final_distance"] > reach
+    rows = [
+        f"| {stated.figure} | {stated.function} | coupled | no | "
+        f"{'no' if separated else 'yes'} (final distance {s['final_distance']:.1f} m, "
+        f"R + R_j = {reach:g} m) | {_yes(separated)} |",
+        f"| {stated.figure} | {stated.function} | RMS velocity change | not stated | "
+        f"{s['rms_change_percent']:+.2f} % | — |",
+    ]
+    note = (
+        f"**{stated.figure}.** The paper shows that attraction alone does not couple the pair. Ours "
+        f"agrees: the agents come as close as {s['min_distance']:.1f} m, are accelerated towards "
+        f"each other on the way in and apart on the way out, and end {s['final_distance']:.1f} m apart, "
+        f"beyond R + R_j. The paper gives no RMS change for this case; ours is "
+        f"{s['rms_change_percent']:+.2f} %."
+    )
+    return rows, note
+
+
+def _switching(stated, s: dict) -> tuple[list[str], str]:
+    """Table rows and note for the paper's Figs. 7 and 9: coupling, uncoupling, RMS change."""
+    pair = s["pairs"][0]
+    uncoupled = pair["uncoupled_at"]
+    separated = pair["separated_at"]
+    in_time = (
+        uncoupled is not None
+        and COMMAND_TIME < uncoupled < UNCOUPLE_BY
+        and separated is not None
+        and separated > DISCONNECTION_AFTER
+    )
+    rms = s["rms_change_percent"]
+    close = abs(rms - stated.rms_change_percent) <= 0.5 * stated.rms_change_percent
+    rows = [
+        f"| {stated.figure} | {stated.function} | coupled | yes | {_yes(s['coupled'])} "
+        f"(at {_t(pair['coupled_at'])}) | {_yes(s['coupled'] == stated.coupled)} |",
+        f"| {stated.figure} | {stated.function} | uncoupling | {stated.disconnection} | "
+        f"F_en drops at {_t(uncoupled)}; spheres apart at {_t(pair['separated_at'])} | {_yes(in_time)} |",
+        f"| {stated.figure} | {stated.function} | RMS velocity change | ≈ {stated.rms_change_percent:g} % | "
+        f"{rms:+.2f} % | {'roughly' if close else 'no'} |",
+    ]
+    note = (
+        f"**{stated.figure}.** The pair couples at {_t(pair['coupled_at'])}, oscillates about "
+        f"{pair['mean_distance_coupled']:.2f} m with an amplitude of {pair['oscillation_amplitude']:.2f} m "
+        f"while coupled, and after the command at {COMMAND_TIME:g} s lets go at {_t(uncoupled)}, the first "
+        f"moment condition (9) holds; the spheres stop intersecting at {_t(pair['separated_at'])}. The paper "
+        f"reports the actual disconnection at {stated.disconnection}: "
+        f"{'consistent' if in_time else 'not consistent'}. " + _rms_sentence(rms, stated.rms_change_percent)
+    )
+    return rows, note
+
+
+def _comparison(summaries: dict[str, dict]) -> str:
+    """The note setting (10) beside (11), as the paper does."""
     amp7 = summaries["fig7"]["pairs"][0]["oscillation_amplitude"]
     amp9 = summaries["fig9"]["pairs"][0]["oscillation_amplitude"]
     rms7 = summaries["fig7"]["rms_change_percent"]
     rms9 = summaries["fig9"]["rms_change_percent"]
-    notes.append(
+    return (
         f"**Fig. 7 against Fig. 9.** The paper finds a larger oscillation while coupled with (11) and a much "
         f"smaller RMS change. Ours: amplitude {amp7:.2f} m with (10) and {amp9:.2f} m with (11) "
         f"({'larger' if amp9 > amp7 else 'not larger'}); RMS change {rms7:+.2f} % against {rms9:+.2f} %, "
         f"a ratio of {rms7 / rms9:.1f} (the paper's is "
         f"{PAPER['fig7'].rms_change_percent / PAPER['fig9'].rms_change_percent:.0f})."
     )
+
+
+_CLOSING = [
+    "**Why the RMS changes differ.** The paper does not give c_max, d_t, eps or its time step. "
+    "docs/sensitivity.md shows how the RMS change moves with each of them (strongly for (10), little for "
+    "(11)), and docs/convergence.md how it converges in dt. tmem switches F_en at the first step inside "
+    "the window of condition (9) (`interaction.switch_at = \"window\"`); the paper's further rule, to "
+    "uncouple when the kinetic energy and f1 − f2 equal their values at coupling, is not implemented. "
+    "docs/reproduction.md discusses each difference.",
+    "",
+    "Each run's directory holds `summary.json`, `trajectory.nc` and the figures `velocity.png` "
+    "(as the paper's velocity plots) and `distance.png`.",
+    "",
+]
+
+
+def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> str:
+    """The Markdown report: the paper's stated results beside ours.
+
+    Parameters
+    ----------
+    summaries
+        :func:`tmem.metrics.summarize` of each run, by preset name (fig5, fig7, fig9).
+    trajectories
+        The runs themselves, by the same names.
+
+    Returns
+    -------
+    str
+    """
+    scenario = trajectories["fig7"].scenario
+    lines = _header(scenario, summaries["fig7"]["gains"])
+    notes: list[str] = []
+    for name, stated in PAPER.items():
+        if stated.function.startswith("attraction"):
+            rows, note = _attraction(stated, summaries[name], scenario.interaction.reach)
+        else:
+            rows, note = _switching(stated, summaries[name])
+        lines += rows
+        notes.append(note)
+    notes.append(_comparison(summaries))
     lines += [
         "",
         f"Agrees: for the uncoupling, F_en drops between {COMMAND_TIME:g} s and {UNCOUPLE_BY:g} s and the spheres "
@@ -174,18 +215,4 @@ def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> s
     ]
     for note in notes:
         lines += [note, ""]
-    lines += [
-        "**Why the RMS changes differ.** The paper does not give c_max, d_t, eps or its time step. "
-        "docs/sensitivity.md shows how the RMS change moves with each of them (strongly for (10), little for "
-        "(11)), and docs/convergence.md how it converges in dt. tmem switches F_en at the first step inside "
-        "the window of condition (9) (`interaction.switch_at = \"window\"`); the paper's further rule, to "
-        "uncouple when the kinetic energy and f1 − f2 equal their values at coupling, is not implemented. "
-        "docs/reproduction.md discusses each difference.",
-        "",
-    ]
-    lines += [
-        "Each run's directory holds `summary.json`, `trajectory.nc` and the figures `velocity.png` "
-        "(as the paper's velocity plots) and `distance.png`.",
-        "",
-    ]
-    return "\n".join(lines)
+    return "\n".join(lines + _CLOSING)
