@@ -148,3 +148,17 @@ def test_each_row_names_a_kernel_and_its_code_dispatches_to_it(row):
             expected = getattr(kernels, row.kernel).py_func(r, f_en, params)
             assert kernels.pair_control.py_func(code, r, f_en, params) == expected
             assert f(row.name, r, f_en) == expected
+
+
+def test_the_documented_table_of_functions_is_the_registry():
+    """docs/equations.md lists one row per registered function, in registry order, with its equation,
+    and a coupled column exactly for the functions that switch on F_en."""
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "equations.md").read_text()
+    rows = [line for line in page.splitlines() if line.startswith("| `")]
+    assert len(rows) == len(interaction.FUNCTIONS)
+    for line, row in zip(rows, interaction.FUNCTIONS):
+        name_cell, _, coupled_cell = [cell.strip() for cell in line.strip("|").split(" | ")][:3]
+        assert name_cell == f"`{row.name}`, {row.equation}"
+        assert (coupled_cell != "—") == row.couples
