@@ -47,7 +47,7 @@ def test_help_works_and_loads_nothing_heavy(args):
 
 
 def test_the_package_names_load_on_first_use():
-    assert tmem.simulate.__module__ == "tmem.engine"
+    assert tmem.simulate.__module__ == "tmem.engine.driver"
     assert tmem.preset("fig9").name
     assert set(tmem.__all__) <= set(dir(tmem))
     for name in tmem.__all__:
