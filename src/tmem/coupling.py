@@ -23,8 +23,10 @@ Where the flag flips is a reading of the paper (``interaction.switch_at``):
   ``|d| = d_t + eps``, where (11)'s f1 and f2 differ by ``2 K_P eps``: a
   small step in control (0.012 rad with the defaults).
 * ``"crossing"`` — at the step where ``|d|`` crosses ``d_t`` (still within
-  eps), the point where (11)'s f1 and f2 agree: no step in control.  (9)'s second line, ``d_t < R +
-R_j``, is a property of the scenario and is checked when it is validated.
+  eps), the point where (11)'s f1 and f2 agree: no step in control.
+
+(9)'s second line, ``d_t < R + R_j``, is a property of the scenario and is
+checked when it is validated.
 """
 
 from __future__ import annotations
