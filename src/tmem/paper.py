@@ -47,6 +47,13 @@ def run_paper(
     """Run the presets ``fig5``, ``fig7``, ``fig9`` into ``out/<name>`` and write ``out/report.md``.
 
     Returns the summaries by preset name and the report text.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output directory (:func:`tmem.io.check_output_directory` says which may be replaced).
+    progress : callable or None
+        Called as ``progress(preset, steps_done, steps_total)`` during each run.
     """
     summaries: dict[str, dict] = {}
     trajectories: dict[str, Trajectory] = {}
@@ -80,7 +87,15 @@ def _rms_sentence(ours: float, paper: float) -> str:
 
 
 def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> str:
-    """The Markdown report: the paper's stated results beside ours."""
+    """The Markdown report: the paper's stated results beside ours.
+
+    Parameters
+    ----------
+    summaries : dict
+        :func:`tmem.metrics.summarize` of each preset, by name (``fig5``, ``fig7``, ``fig9``).
+    trajectories : dict
+        The runs, by the same names.
+    """
     scenario = trajectories["fig7"].scenario
     ia, sim = scenario.interaction, scenario.simulation
     lines = [
