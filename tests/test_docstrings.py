@@ -27,6 +27,7 @@ import inspect
 import pkgutil
 import re
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import pytest
 
@@ -185,6 +186,14 @@ def test_the_walk_finds_the_public_modules():
     }  # fmt: skip
     assert expected <= modules, sorted(expected - modules)
     assert not any(part.startswith("_") for name in modules for part in name.split("."))
+
+
+def test_every_public_module_has_a_page_in_the_api_reference():
+    api = Path(__file__).resolve().parents[1] / "docs" / "api"
+    pages = {m for page in api.glob("*.rst") for m in re.findall(r"^\.\. automodule:: (\S+)", page.read_text(), re.M)}
+    assert set(public_modules()) <= pages, f"add a page to docs/api (and index.rst) for {sorted(set(public_modules()) - pages)}"
+    index = (api / "index.rst").read_text()
+    assert all(re.search(rf"^   {re.escape(page.stem)}$", index, re.M) for page in api.glob("tmem*.rst"))
 
 
 def test_every_public_function_documents_its_parameters():

@@ -4,16 +4,18 @@ Build from the repository root (``pip install -e '.[docs]'`` first)::
 
     sphinx-build -W --keep-going -b html docs/api docs/api/_build/html
 
-numpydoc renders the numpy-style sections (Parameters, Returns, Attributes);
-autodoc reads the docstrings, those of Numba-compiled functions through their
-``py_func``.
+numpydoc renders the numpy-style sections (Parameters, Returns, Attributes).
+autodoc documents Numba-compiled functions as functions: a ``CPUDispatcher``
+is a routine carrying its Python function's docstring, and its signature
+through ``__wrapped__`` (its ``py_func``).  ``tests/test_docstrings.py``
+checks that every public module has a page here and every parameter is
+documented.
 """
 
 from __future__ import annotations
 
 import importlib
 import inspect
-import os
 import sys
 from pathlib import Path
 
@@ -24,8 +26,6 @@ from sphinx.util.docutils import SphinxDirective
 
 # The checkout's source first, so that the reference describes the code beside it.
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "src"))
-# Importing the compiled modules must not write Numba's cache into a read-only tree.
-os.environ.setdefault("NUMBA_CACHE_DIR", str(Path(__file__).resolve().parent / "_build" / "numba_cache"))
 
 import tmem  # noqa: E402
 
