@@ -47,6 +47,7 @@ class BatchResult:
 
     @property
     def coupled(self) -> np.ndarray:
+        """Whether each case coupled, shape (cases,), bool."""
         return ~np.isnan(self.couple_time)
 
 
@@ -148,6 +149,11 @@ def unsupported(scenario: Scenario) -> str | None:
     start without a formation, at most one command (an uncouple).  Only the
     agents' positions and velocities vary; their tilts and tilt rates start at
     zero.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The base scenario of the cases.
     """
     if scenario.model.kind != "linear":
         return "needs the linear model (2): a batch steps the pair's relative state"

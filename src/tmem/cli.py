@@ -79,7 +79,16 @@ def run(
     scenario: Path = typer.Argument(..., help="Scenario TOML file (see examples/)."),
     out: Path = typer.Option(..., "--out", "-o", help="Output directory (replaced if it holds an earlier run)."),
 ) -> None:
-    """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT."""
+    """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT.
+
+    \f
+    Parameters
+    ----------
+    scenario : Path
+        Scenario TOML file.
+    out : Path
+        Output directory (replaced if it holds an earlier run).
+    """
     from .engine import SimulationError, simulate
     from .io import OutputError, check_output_directory, write_run
     from .scenario import ScenarioError, load
@@ -102,7 +111,14 @@ def run(
 def paper(
     out: Path = typer.Option(Path("out/paper"), "--out", "-o", help="Output directory."),
 ) -> None:
-    """Reproduce the paper's Figs. 5, 7 and 9 into OUT/fig5, OUT/fig7, OUT/fig9 and OUT/report.md."""
+    """Reproduce the paper's Figs. 5, 7 and 9 into OUT/fig5, OUT/fig7, OUT/fig9 and OUT/report.md.
+
+    \f
+    Parameters
+    ----------
+    out : Path
+        Output directory.
+    """
     from .engine import SimulationError
     from .io import OutputError
     from .paper import run_paper
@@ -125,7 +141,20 @@ def animate_command(
     fps: int = typer.Option(20, help="Frames per second."),
     max_frames: int = typer.Option(400, help="Most frames; the recorded times are thinned evenly."),
 ) -> None:
-    """Animate a 2-D run: agents, interaction circles, coupled pairs and a clock."""
+    """Animate a 2-D run: agents, interaction circles, coupled pairs and a clock.
+
+    \f
+    Parameters
+    ----------
+    run_dir : Path
+        A run directory written by ``tmem run``.
+    out : Path or None
+        Animation file (``.gif``, or ``.mp4`` with ffmpeg); default ``RUN_DIR/animation.gif``.
+    fps : int
+        Frames per second.
+    max_frames : int
+        Most frames; the recorded times are thinned evenly.
+    """
     from .animate import animate
 
     try:
@@ -142,7 +171,20 @@ def sweep_command(
     scheduler: str = typer.Option(None, help="Address of an existing Dask scheduler; default: a local cluster."),
     workers: int = typer.Option(None, min=1, help="Worker processes of the local cluster; default: one per core."),
 ) -> None:
-    """Run every case of SWEEP_FILE on Dask; write results.parquet, summary.md and figures to OUT."""
+    """Run every case of SWEEP_FILE on Dask; write results.parquet, summary.md and figures to OUT.
+
+    \f
+    Parameters
+    ----------
+    sweep_file : Path
+        Sweep TOML file (``docs/sweeps.md``).
+    out : Path
+        Output directory; run again to resume an interrupted sweep.
+    scheduler : str or None
+        Address of an existing Dask scheduler; default: a local cluster.
+    workers : int or None
+        Worker processes of the local cluster; default: one per core.
+    """
     from .io import OutputError
     from .sweep import SweepError, SweepInterrupted, load_sweep, run_sweep
 

@@ -25,7 +25,19 @@ from . import _numba_cache  # noqa: F401  (drops stale compiled code before any 
 
 
 def roots(r_l: float, im_l: float, im_r: float) -> np.ndarray:
-    """The desired closed-loop roots (5), ``(-r_l -+ i im_l, -+ i im_r)``."""
+    """The desired closed-loop roots (5), ``(-r_l -+ i im_l, -+ i im_r)``.
+
+    Parameters
+    ----------
+    r_l, im_l : float
+        Real part and imaginary part of the damped left pair (1/s).
+    im_r : float
+        Imaginary part of the undamped right pair (1/s).
+
+    Returns
+    -------
+    ndarray, shape (4,), complex
+    """
     return np.array([-r_l - 1j * im_l, -r_l + 1j * im_l, -1j * im_r, 1j * im_r])
 
 
@@ -108,6 +120,17 @@ def printed_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r:
     entry is ``K_V``, the second ``K_P``), and the third lacks the ``- 1``:
     ``K_phi`` comes out as 0.962 instead of -0.038.  Do not use these gains to
     simulate; use :func:`modal_gains`.
+
+    Parameters
+    ----------
+    kp, kd, g
+        The model's parameters (1)-(2), Table 1.
+    r_l, im_l, im_r
+        The roots (5), Table 1.
+
+    Returns
+    -------
+    ndarray, shape (4,)
     """
     p1, p2, p3, p4 = roots(r_l, im_l, im_r)
     beta = 1.0 / (kp * kd)
@@ -141,5 +164,12 @@ def corrected_position(p, v, phi, omega, gains):
 
     The same quantity as :func:`interaction_point`, for the step loop and the batch; the sum runs
     in the order of the state, so every caller gets the same bits.
+
+    Parameters
+    ----------
+    p, v, phi, omega : float
+        Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
+    gains : ndarray, shape (4,)
+        ``K`` from :func:`modal_gains`.
     """
     return (p * gains[0] + v * gains[1] + phi * gains[2] + omega * gains[3]) / gains[0]

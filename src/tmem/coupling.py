@@ -23,8 +23,10 @@ Where the flag flips is a reading of the paper (``interaction.switch_at``):
   ``|d| = d_t + eps``, where (11)'s f1 and f2 differ by ``2 K_P eps``: a
   small step in control (0.012 rad with the defaults).
 * ``"crossing"`` — at the step where ``|d|`` crosses ``d_t`` (still within
-  eps), the point where (11)'s f1 and f2 agree: no step in control.  (9)'s second line, ``d_t < R +
-R_j``, is a property of the scenario and is checked when it is validated.
+  eps), the point where (11)'s f1 and f2 agree: no step in control.
+
+(9)'s second line, ``d_t < R + R_j``, is a property of the scenario and is
+checked when it is validated.
 """
 
 from __future__ import annotations
@@ -42,7 +44,26 @@ EVENT_COMMAND, EVENT_COUPLE, EVENT_UNCOUPLE = range(3)
 
 @numba.njit(cache=True)
 def next_flag(f_en, armed, r_before, r, d_t, eps, at_crossing):
-    """The pair flag after a step that took the pair measure from ``r_before`` to ``r`` (see module text)."""
+    """The pair flag after a step that took the pair measure from ``r_before`` to ``r`` (see module text).
+
+    Parameters
+    ----------
+    f_en : int
+        The pair flag ``F_en`` before the step (0 or 1).
+    armed : bool
+        The operator's intent: the pair may be coupled.
+    r_before, r : float
+        The pair measure ``|d|`` before and after the step (m).
+    d_t, eps : float
+        Set distance of the pair and the coupling window (9) (m).
+    at_crossing : bool
+        Switch only where ``r`` crosses ``d_t`` (``interaction.switch_at = "crossing"``).
+
+    Returns
+    -------
+    int
+        ``F_en`` after the step.
+    """
     reached = abs(r - d_t) < eps
     if at_crossing:
         reached = reached and (r_before - d_t) * (r - d_t) <= 0.0

@@ -67,13 +67,37 @@ def _with_edges(positions: np.ndarray, edges: list[tuple[int, int]], d_t: float,
 
 
 def chain(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Formation:
-    """``n`` agents along x, ``d_t`` apart, each coupled to the next."""
+    """``n`` agents along x, ``d_t`` apart, each coupled to the next.
+
+    Parameters
+    ----------
+    n : int
+        Number of agents.
+    d_t : float
+        Set distance of each coupled pair (m).
+    axes : int
+        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
+    bearing : bool
+        Whether each pair also holds its direction ``P_j - P_i``.
+    """
     points = np.stack([np.arange(n) * d_t, np.zeros(n)], axis=1)
     return _with_edges(_place(points, axes), [(k, k + 1) for k in range(n - 1)], d_t, bearing)
 
 
 def ring(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Formation:
-    """A regular ``n``-gon of side ``d_t``, each agent coupled to both its neighbours."""
+    """A regular ``n``-gon of side ``d_t``, each agent coupled to both its neighbours.
+
+    Parameters
+    ----------
+    n : int
+        Number of agents.
+    d_t : float
+        Set distance of each coupled pair (m).
+    axes : int
+        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
+    bearing : bool
+        Whether each pair also holds its direction ``P_j - P_i``.
+    """
     if n < 3:
         raise ValueError(f"a ring needs at least 3 agents, got {n}")
     radius = d_t / (2.0 * np.sin(np.pi / n))
@@ -83,7 +107,17 @@ def ring(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Formation:
 
 
 def triangle(d_t: float, axes: int = 2, bearing: bool = False) -> Formation:
-    """Three agents, all coupled (Fig. 1)."""
+    """Three agents, all coupled (Fig. 1).
+
+    Parameters
+    ----------
+    d_t : float
+        Set distance of each coupled pair (m).
+    axes : int
+        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
+    bearing : bool
+        Whether each pair also holds its direction ``P_j - P_i``.
+    """
     return ring(3, d_t, axes, bearing)
 
 
@@ -94,6 +128,17 @@ def hex_patch(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Forma
     broken by angle, so the patch is the same on every machine.  Lattice
     point ``(a, b)`` sits at ``d_t (a + b / 2, b sqrt(3) / 2)``; its six
     neighbours differ by one of :data:`_HEX_NEIGHBOURS`.
+
+    Parameters
+    ----------
+    n : int
+        Number of agents.
+    d_t : float
+        Set distance of each coupled pair (m).
+    axes : int
+        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
+    bearing : bool
+        Whether each pair also holds its direction ``P_j - P_i``.
     """
     span = int(np.ceil(np.sqrt(n))) + 2
     a, b = (g.ravel() for g in np.meshgrid(np.arange(-span, span + 1), np.arange(-span, span + 1)))
@@ -116,7 +161,21 @@ _HEX_NEIGHBOURS = ((1, 0), (0, 1), (-1, 1))
 
 
 def generate(kind: str, n: int, d_t: float, axes: int, bearing: bool = False) -> Formation:
-    """The formation ``kind`` (``chain``, ``ring``, ``triangle`` or ``hex``) of ``n`` agents."""
+    """The formation ``kind`` (``chain``, ``ring``, ``triangle`` or ``hex``) of ``n`` agents.
+
+    Parameters
+    ----------
+    kind : str
+        ``"chain"``, ``"ring"``, ``"triangle"`` (``n`` ignored: 3) or ``"hex"``.
+    n : int
+        Number of agents.
+    d_t : float
+        Set distance of each coupled pair (m).
+    axes : int
+        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
+    bearing : bool
+        Whether each pair also holds its direction ``P_j - P_i``.
+    """
     if kind == "chain":
         return chain(n, d_t, axes, bearing)
     if kind == "ring":

@@ -82,7 +82,13 @@ def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
 
 
 def build(scenario: Scenario) -> InitialArrays:
-    """The initial arrays of ``scenario``."""
+    """The initial arrays of ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its agents, swarm or formation, pairs and box set the arrays.
+    """
     axes = scenario.space.axes
     n = scenario.n_agents
     f = scenario.formation

@@ -47,6 +47,11 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     of the recorded agents over time.  Units are in each variable's
     attributes; the scenario (as TOML), the gains and the events are in the
     dataset's attributes.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
     """
     n_axes = trajectory.scenario.space.axes
     coords = {
@@ -109,6 +114,11 @@ def check_output_directory(out: str | Path) -> Path:
     empty directory, or one holding nothing but what tmem writes.  Refused: a
     file, a symbolic link, the current directory or one containing it, a
     directory holding anything else, a path below a file.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output directory asked for.
     """
     out = Path(out)
     if out.is_symlink():
@@ -132,6 +142,11 @@ def atomic_directory(out: str | Path) -> Iterator[Path]:
 
     Parent directories made for it are removed again if the block fails.  File
     system errors (no permission, disk full) become :class:`OutputError`.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output directory, checked by :func:`check_output_directory`.
     """
     out = check_output_directory(out)
     missing = [p for p in reversed(out.absolute().parents) if not p.exists()]
@@ -166,7 +181,20 @@ def _remove_made(directories: list[Path]) -> None:
 
 
 def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
-    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``."""
+    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    directory : Path
+        An existing directory.
+
+    Returns
+    -------
+    dict
+        The summary (:func:`tmem.metrics.summarize`).
+    """
     summary = metrics.summarize(trajectory)
     (directory / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
     to_dataset(trajectory).to_netcdf(directory / "trajectory.nc", engine="h5netcdf")
@@ -175,6 +203,14 @@ def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
 
 
 def write_run(trajectory: Trajectory, out: str | Path) -> dict:
-    """Write a complete run directory at ``out`` (atomically) and return its summary."""
+    """Write a complete run directory at ``out`` (atomically) and return its summary.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    out : str or Path
+        The run directory (:func:`check_output_directory` says which may be replaced).
+    """
     with atomic_directory(out) as tmp:
         return write_run_files(trajectory, tmp)

@@ -31,7 +31,22 @@ def rms_velocity(velocity: np.ndarray, active: np.ndarray | None = None) -> np.n
 
 
 def nearest_distance(positions: np.ndarray, active: np.ndarray, box: np.ndarray) -> float | None:
-    """Smallest distance between two active agents (nearest image in a periodic box)."""
+    """Smallest distance between two active agents (nearest image in a periodic box).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (agents, axes)
+        Positions (m).
+    active : ndarray, shape (agents,), bool
+        The agents that count.
+    box : ndarray, shape (axes,)
+        Periodic box sides (m); 0 on an open axis.
+
+    Returns
+    -------
+    float or None
+        ``None`` with fewer than two active agents.
+    """
     points = positions[active]
     if len(points) < 2:
         return None
@@ -54,6 +69,13 @@ def pair_summary(trajectory: Trajectory, p: int) -> dict:
     peak-to-peak distance over the recorded samples with ``F_en = 1``;
     ``distance_error`` the mean, RMS and largest ``|distance - d_t|`` over the
     same samples.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    p : int
+        Index of the pair in ``trajectory.pairs``.
     """
     agents = tuple(int(a) for a in trajectory.pairs[p])
     events = [e for e in trajectory.events if e.agents == agents]
@@ -94,6 +116,11 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
     largest angle between a pair's direction ``P_j - P_i`` and the direction it
     must hold (pairs that hold one); ``formed_at``: when the last pair coupled,
     if all did; ``coupled_at_end``: the share of pairs coupled at the end.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
     """
     scenario = trajectory.scenario
     if scenario.formation is None or not len(trajectory.pairs):
@@ -123,7 +150,13 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
 
 
 def direction_error_deg(trajectory: Trajectory) -> float | None:
-    """Largest angle (degrees) between a recorded pair's direction and the one it must hold."""
+    """Largest angle (degrees) between a recorded pair's direction and the one it must hold.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    """
     direction = trajectory.initial.direction
     position = {int(a): q for q, a in enumerate(trajectory.agents)}
     worst = None
@@ -142,7 +175,13 @@ def direction_error_deg(trajectory: Trajectory) -> float | None:
 
 
 def summarize_events(events: list[Event]) -> list[dict]:
-    """Events as JSON-ready dicts; ``agents`` is ``[]`` for a command to several or every pair."""
+    """Events as JSON-ready dicts; ``agents`` is ``[]`` for a command to several or every pair.
+
+    Parameters
+    ----------
+    events : list of Event
+        A run's events (:attr:`tmem.engine.trajectory.Trajectory.events`).
+    """
     rows = []
     for e in events:
         row = {"time": e.time, "kind": e.kind, "agents": list(e.agents)}
@@ -160,6 +199,11 @@ def summarize(trajectory: Trajectory) -> dict:
     ``final_distance`` the smallest distance between two flying agents at the
     end; ``coupled`` whether any pair coupled; ``couple_time`` /
     ``uncouple_time`` the first such event of any pair.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
     """
     scenario = trajectory.scenario
     model = trajectory.model

@@ -34,7 +34,13 @@ from . import _numba_cache  # noqa: F401  (drops stale compiled code before any 
 
 
 def all_pairs(active: np.ndarray) -> np.ndarray:
-    """Every pair ``(i, j)``, ``i < j``, of active agents, once, sorted: shape (pairs, 2), unsigned."""
+    """Every pair ``(i, j)``, ``i < j``, of active agents, once, sorted: shape (pairs, 2), unsigned.
+
+    Parameters
+    ----------
+    active : ndarray, shape (agents,), bool
+        The flying agents.
+    """
     flying = np.flatnonzero(active)
     first, second = np.triu_indices(len(flying), k=1)
     return np.stack([flying[first], flying[second]], axis=1).astype(np.uint32)
@@ -42,7 +48,15 @@ def all_pairs(active: np.ndarray) -> np.ndarray:
 
 @numba.njit(cache=True, inline="always")
 def nearest_image(delta, side):
-    """``delta`` taken to the nearest periodic image along an axis of length ``side`` (0: not periodic)."""
+    """``delta`` taken to the nearest periodic image along an axis of length ``side`` (0: not periodic).
+
+    Parameters
+    ----------
+    delta : float
+        A difference of positions along the axis (m).
+    side : float
+        The box side along the axis (m); 0 on an open axis.
+    """
     if abs(delta) < 0.25 * side:
         return delta  # what the rounding below gives, without a division
     if side > 0.0:
@@ -52,7 +66,15 @@ def nearest_image(delta, side):
 
 @numba.njit(cache=True, inline="always")
 def into_box(position, side):
-    """``position`` taken into ``[0, side)`` along a periodic axis (``side > 0``)."""
+    """``position`` taken into ``[0, side)`` along a periodic axis (``side > 0``).
+
+    Parameters
+    ----------
+    position : float
+        A position along the axis (m).
+    side : float
+        The box side along the axis (m).
+    """
     return position - side * np.floor(position / side)
 
 
@@ -233,6 +255,23 @@ def verlet_pairs(points, active, cutoff, box, pairs, found, parts):
     searched side by side (:func:`_search`), each into its share of ``found``
     (shape (2, room), int32).  If ``pairs`` or a share of ``found`` is too
     small, nothing is filled; the caller must grow them and call again.
+
+    Parameters
+    ----------
+    points : ndarray, shape (agents, axes)
+        The points, ``P*`` (m).
+    active : ndarray, shape (agents,), bool
+        The points that take part.
+    cutoff : float
+        The list's reach, ``R + R_j + skin`` (m).
+    box : tuple of float
+        Periodic box sides (m); 0 on an open axis.
+    pairs : ndarray, shape (capacity, 2), uint32
+        Filled with the pairs.
+    found : ndarray, shape (2, room), int32
+        Work space of the parts.
+    parts : int
+        Number of parts searched side by side.
     """
     n = points.shape[0]
     axes = len(box)  # a tuple: compiled for each number of axes
@@ -285,7 +324,15 @@ def verlet_pairs(points, active, cutoff, box, pairs, found, parts):
 
 @numba.njit(cache=True)
 def is_partner(adj_ptr, adj_idx, i, j):
-    """Whether agents ``i`` and ``j`` are a formation pair (rows ``adj_ptr``, ``adj_idx`` of partners)."""
+    """Whether agents ``i`` and ``j`` are a formation pair (rows ``adj_ptr``, ``adj_idx`` of partners).
+
+    Parameters
+    ----------
+    adj_ptr, adj_idx : ndarray
+        Partners of agent ``i``: ``adj_idx[adj_ptr[i]:adj_ptr[i + 1]]``.
+    i, j : int
+        The agents.
+    """
     for e in range(adj_ptr[i], adj_ptr[i + 1]):
         if adj_idx[e] == j:
             return True
@@ -303,6 +350,19 @@ def arrange(pairs, n_pairs, adj_ptr, adj_idx, block, block_ptr):
     pairs that cross from one block to another follow, also sorted.  Blocks
     can then be summed on separate threads without two writing to the same
     agent, and the crossing pairs after them on one.
+
+    Parameters
+    ----------
+    pairs : ndarray, shape (>= n_pairs, 2)
+        Sorted pairs, rearranged in place.
+    n_pairs : int
+        Number of pairs listed.
+    adj_ptr, adj_idx : ndarray
+        Formation partners of each agent, as for :func:`is_partner`.
+    block : int
+        Agents per block.
+    block_ptr : ndarray, shape (blocks + 1,)
+        Filled with where each block's pairs begin.
     """
     crossing = np.empty((n_pairs, 2), dtype=pairs.dtype)
     n_inside = 0
@@ -329,6 +389,18 @@ def arrange(pairs, n_pairs, adj_ptr, adj_idx, block, block_ptr):
 
 
 def spatial_order(points: np.ndarray, active: np.ndarray, side: float, box: np.ndarray) -> np.ndarray:
-    """A numbering of the agents in which neighbours are close: active agents by cells of ``side``, then the rest."""
+    """A numbering of the agents in which neighbours are close: active agents by cells of ``side``, then the rest.
+
+    Parameters
+    ----------
+    points : ndarray, shape (agents, axes)
+        The points, ``P*`` (m).
+    active : ndarray, shape (agents,), bool
+        The flying agents.
+    side : float
+        Side of the cells (m).
+    box : ndarray, shape (axes,)
+        Periodic box sides (m); 0 on an open axis.
+    """
     cells_order = _cells(points, active, side, box)[3]
     return np.concatenate([cells_order, np.flatnonzero(~active)]).astype(np.int64)

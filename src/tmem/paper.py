@@ -47,6 +47,13 @@ def run_paper(
     """Run the presets ``fig5``, ``fig7``, ``fig9`` into ``out/<name>`` and write ``out/report.md``.
 
     Returns the summaries by preset name and the report text.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output directory (:func:`tmem.io.check_output_directory` says which may be replaced).
+    progress : callable or None
+        Called as ``progress(preset, steps_done, steps_total)`` during each run.
     """
     summaries: dict[str, dict] = {}
     trajectories: dict[str, Trajectory] = {}

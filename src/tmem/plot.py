@@ -43,7 +43,13 @@ def _mark_events(ax, trajectory: Trajectory) -> None:
 
 
 def velocity_figure(trajectory: Trajectory):
-    """Velocities of (up to MAX_DRAWN) agents and the RMS velocity against time."""
+    """Velocities of (up to MAX_DRAWN) agents and the RMS velocity against time.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    """
     fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
     t = trajectory.time
     velocity = trajectory.model.velocity(trajectory.state)
@@ -63,7 +69,13 @@ def velocity_figure(trajectory: Trajectory):
 
 
 def distance_figure(trajectory: Trajectory):
-    """Distances of (up to MAX_DRAWN of the closest) pairs with ``R + R_j`` and ``d_t``, above ``F_en``."""
+    """Distances of (up to MAX_DRAWN of the closest) pairs with ``R + R_j`` and ``d_t``, above ``F_en``.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    """
     fig, (top, bottom) = plt.subplots(
         2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained"
     )
@@ -90,7 +102,13 @@ def distance_figure(trajectory: Trajectory):
 
 
 def formation_figure(trajectory: Trajectory):
-    """Distance error ``| |P_j - P_i| - d_t |`` of the coupled formation pairs: mean, RMS and largest."""
+    """Distance error ``| |P_j - P_i| - d_t |`` of the coupled formation pairs: mean, RMS and largest.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    """
     fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
     coupled = trajectory.flag == 1
     error = np.where(coupled, np.abs(trajectory.pair_distance - trajectory.d_t), 0.0)
@@ -110,7 +128,22 @@ def formation_figure(trajectory: Trajectory):
 
 
 def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
-    """Write ``velocity.png`` (if agents were recorded), ``distance.png`` (if pairs) and ``formation.png``."""
+    """Write ``velocity.png`` (if agents were recorded), ``distance.png`` (if pairs) and ``formation.png``.
+
+    ``formation.png`` only for a scenario with a formation.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    directory : Path
+        An existing directory.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     makers = []
     if trajectory.state.shape[1]:  # some agents recorded
         makers.append(("velocity.png", velocity_figure))

@@ -39,11 +39,25 @@ class Sensing(NamedTuple):
 
 
 def exact(state: np.ndarray) -> Sensing:
-    """Every agent knows every state exactly: no work space is needed."""
+    """Every agent knows every state exactly: no work space is needed.
+
+    Parameters
+    ----------
+    state : ndarray, shape (agents, axes, n_state)
+        The states of the run (only their shape is used).
+    """
     return Sensing(IDENTITY, np.empty((0,) + state.shape[1:]))
 
 
 @numba.njit(cache=True, inline="always")
 def measure(state, sensing):
-    """The states as the agents know them, shape of ``state``: ``state`` itself for :data:`IDENTITY`."""
+    """The states as the agents know them, shape of ``state``: ``state`` itself for :data:`IDENTITY`.
+
+    Parameters
+    ----------
+    state : ndarray, shape (agents, axes, n_state)
+        The true states.
+    sensing : Sensing
+        The effect and its work space.
+    """
     return state

@@ -45,7 +45,15 @@ BLOCK = 4096
 
 
 def record_steps(n_steps: int, record_every: int) -> np.ndarray:
-    """The step indices that are recorded: multiples of ``record_every`` and the last step."""
+    """The step indices that are recorded: multiples of ``record_every`` and the last step.
+
+    Parameters
+    ----------
+    n_steps : int
+        Steps of the run.
+    record_every : int
+        Record every this many steps.
+    """
     steps = np.arange(0, n_steps + 1, record_every)
     if steps[-1] != n_steps:
         steps = np.append(steps, n_steps)
@@ -53,7 +61,20 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
 
 
 def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
-    """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters."""
+    """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario whose ``[interaction]`` table sets the law.
+    gains : ndarray, shape (4,)
+        ``K`` placing the roots (5) (:func:`tmem.control.gains_for`).
+
+    Returns
+    -------
+    Law
+    FunctionParams
+    """
     ia = scenario.interaction
     couples = uses_coupling(ia.function)
     law = Law(

@@ -25,7 +25,13 @@ from .stages import apply_commands, corrected_positions, formation_pairs, is_rec
 
 
 def vehicle_step(x, u, i, scale, params, n_axes):
-    """Placeholder for the vehicle model's compiled step, bound by :func:`advance_for`."""
+    """Placeholder for the vehicle model's compiled step, bound by :func:`advance_for`.
+
+    Parameters
+    ----------
+    x, u, i, scale, params, n_axes
+        As :attr:`tmem.model.base.VehicleModel.step` takes them.
+    """
     raise NotImplementedError("the step loop is compiled by advance_for, which binds the vehicle model's step")
 
 

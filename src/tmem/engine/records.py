@@ -205,4 +205,5 @@ class Counters(NamedTuple):
 
     @classmethod
     def zero(cls) -> "Counters":
+        """The counters at the start of a run: every one 0."""
         return cls(*(np.zeros(1, dtype=np.int64) for _ in cls._fields))

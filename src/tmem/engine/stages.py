@@ -35,7 +35,21 @@ CHUNK = 256
 
 @numba.njit(cache=True, inline="always")
 def log_event(events, counters, k, kind, i, j, action):
-    """Append an event at step ``k`` (agents as slots, -1 for none; action -1 for none)."""
+    """Append an event at step ``k`` (agents as slots, -1 for none; action -1 for none).
+
+    Parameters
+    ----------
+    events, counters
+        The loop's records (:mod:`tmem.engine.records`), changed in place.
+    k : int
+        The step.
+    kind : int
+        Event kind (:data:`tmem.coupling.EVENT_KINDS`).
+    i, j : int
+        Slots of the agents, -1 for none.
+    action : int
+        Command code (:data:`tmem.engine.records.COMMANDS`), -1 for none.
+    """
     n = counters.n_events[0]
     events.step[n] = k
     events.kind[n] = kind
@@ -51,6 +65,13 @@ def apply_commands(k, commands, agents, pairs, events, counters):
 
     ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.coupling`); ``remove`` stops an agent
     where it is (a lost vehicle), ``add`` puts it back at its start.
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    commands, agents, pairs, events, counters
+        The loop's records (:mod:`tmem.engine.records`); all but ``commands`` change in place.
     """
     rebuild = False
     while counters.next_command[0] < commands.step.shape[0] and commands.step[counters.next_command[0]] <= k:
@@ -85,6 +106,13 @@ def corrected_positions(known, agents, law, run, neighbours):
 
     Returns the largest squared shift of a flying agent's ``P*`` since the lists were built (0
     without lists).
+
+    Parameters
+    ----------
+    known : ndarray, shape (agents, axes, n_state)
+        The states as measured (:func:`tmem.sensing.measure`).
+    agents, law, run, neighbours
+        The loop's records (:mod:`tmem.engine.records`); ``agents`` changes in place.
     """
     box = run.box
     n_axes = len(box)
@@ -165,6 +193,13 @@ def neighbour_pushes(agents, neighbours, law, params, run):
     Each block's own pairs run on a thread of their own, then the pairs crossing between blocks, so
     every agent adds its pushes in one order whatever the number of threads.  ``f`` is the
     function of :attr:`Law.neighbour_function`, with the scenario's ``d_t``.
+
+    Parameters
+    ----------
+    agents, neighbours, law, run
+        The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``neighbours`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters.
     """
     box = run.box
     function = law.neighbour_function
@@ -221,7 +256,17 @@ def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
 def formation_pairs(k, agents, pairs, law, params, run, events, counters):
     """Each formation pair: its flag ``F_en`` after this step's check (:func:`tmem.coupling.next_flag`,
     (9)), its smallest distance, and its pull or push on both agents.  A pair whose agent was removed
-    uncouples and rests."""
+    uncouples and rests.
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    agents, pairs, law, run, events, counters
+        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters; each pair's own ``d_t`` replaces the scenario's.
+    """
     d = np.empty(len(run.box))
     for e in range(pairs.i.shape[0]):
         i = pairs.i[e]
@@ -247,7 +292,19 @@ def formation_pairs(k, agents, pairs, law, params, run, events, counters):
 
 @numba.njit(cache=True, inline="always")
 def tilt_scale(u, i, n_axes, c_max):
-    """The factor that saturates agent ``i``'s summed set-point on its norm, ``|U| <= c_max``."""
+    """The factor that saturates agent ``i``'s summed set-point on its norm, ``|U| <= c_max``.
+
+    Parameters
+    ----------
+    u : ndarray, shape (agents, axes)
+        Summed set-points (rad).
+    i : int
+        The agent's slot.
+    n_axes : int
+        Number of axes.
+    c_max : float
+        Tilt limit (rad).
+    """
     norm2 = 0.0
     for a in range(n_axes):
         norm2 += u[i, a] * u[i, a]
@@ -256,13 +313,29 @@ def tilt_scale(u, i, n_axes, c_max):
 
 @numba.njit(cache=True, inline="always")
 def is_recorded(k, run):
-    """Whether step ``k`` is recorded: a multiple of ``record_every``, and the last step."""
+    """Whether step ``k`` is recorded: a multiple of ``record_every``, and the last step.
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    run : Run
+        What stays fixed over the run.
+    """
     return run.record_every > 0 and (k % run.record_every == 0 or k == run.n_steps)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def record(agents, pairs, records, c_max, run, counters):
-    """Record the step, before the vehicles move, with the saturated set-point applied over it."""
+    """Record the step, before the vehicles move, with the saturated set-point applied over it.
+
+    Parameters
+    ----------
+    agents, pairs, records, run, counters
+        The loop's records (:mod:`tmem.engine.records`); ``records`` and ``counters`` change in place.
+    c_max : float
+        Tilt limit (rad).
+    """
     n_axes = len(run.box)
     q_record = counters.next_record[0]
     for q in range(records.slots.shape[0]):

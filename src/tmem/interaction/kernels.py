@@ -87,25 +87,65 @@ def _spring(r, p):
 
 @numba.njit(cache=True, inline="always")
 def repulsion(r, f_en, p):
-    """Repulsion (8): ``K_P (r - reach)`` for ``r < reach``, else 0; saturated.  ``f_en`` is unused."""
+    """Repulsion (8): ``K_P (r - reach)`` for ``r < reach``, else 0; saturated.  ``f_en`` is unused.
+
+    Parameters
+    ----------
+    r : float
+        The pair measure's size ``|d|`` (m).
+    f_en : int
+        The pair flag ``F_en``.
+    p : FunctionParams
+        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    """
     return _saturate(_overlap(r, p), p.c_max)
 
 
 @numba.njit(cache=True, inline="always")
 def attraction(r, f_en, p):
-    """Attraction (Fig. 3): ``K_P (r - d_t)`` for ``r < reach``, else 0; saturated.  ``f_en`` is unused."""
+    """Attraction (Fig. 3): ``K_P (r - d_t)`` for ``r < reach``, else 0; saturated.  ``f_en`` is unused.
+
+    Parameters
+    ----------
+    r : float
+        The pair measure's size ``|d|`` (m).
+    f_en : int
+        The pair flag ``F_en``.
+    p : FunctionParams
+        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    """
     return _saturate(_spring(r, p), p.c_max) if r < p.reach else 0.0
 
 
 @numba.njit(cache=True, inline="always")
 def switching(r, f_en, p):
-    """Switching (10): f1 = repulsion (8) if ``f_en == 0``, else f2 = ``K_P (r - d_t)``; saturated."""
+    """Switching (10): f1 = repulsion (8) if ``f_en == 0``, else f2 = ``K_P (r - d_t)``; saturated.
+
+    Parameters
+    ----------
+    r : float
+        The pair measure's size ``|d|`` (m).
+    f_en : int
+        The pair flag ``F_en``.
+    p : FunctionParams
+        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    """
     return _saturate(_overlap(r, p) if f_en == 0 else _spring(r, p), p.c_max)
 
 
 @numba.njit(cache=True, inline="always")
 def improved_switching(r, f_en, p):
-    """Improved switching (11): the continuous f1 if ``f_en == 0``, else f2; saturated."""
+    """Improved switching (11): the continuous f1 if ``f_en == 0``, else f2; saturated.
+
+    Parameters
+    ----------
+    r : float
+        The pair measure's size ``|d|`` (m).
+    f_en : int
+        The pair flag ``F_en``.
+    p : FunctionParams
+        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    """
     if f_en != 0 or r < p.d_t:
         u = _spring(r, p)
     elif r <= 0.5 * (p.d_t + p.reach):
@@ -130,7 +170,10 @@ def _compile_dispatch():
     dispatch = numba.njit(inline="always")(namespace["pair_control"])
     dispatch.__doc__ = (
         "``U`` of the function with integer code ``function`` (its registry row) for one pair: "
-        "``kernel(r, f_en, p)``, ``r = |d|``."
+        "``kernel(r, f_en, p)``, ``r = |d|``.\n\n"
+        "Parameters\n----------\n"
+        "function : int\n    The registry code (:func:`tmem.interaction.registry.code`).\n"
+        "r, f_en, p\n    As the kernels take them: ``|d|`` (m), ``F_en``, :class:`FunctionParams`.\n"
     )
     return dispatch
 

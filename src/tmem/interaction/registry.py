@@ -67,10 +67,22 @@ FUNCTION_NAMES: tuple[str, ...] = tuple(row.name for row in FUNCTIONS)
 
 
 def code(name: str) -> int:
-    """The integer code of the function called ``name`` (its place in :data:`FUNCTIONS`)."""
+    """The integer code of the function called ``name`` (its place in :data:`FUNCTIONS`).
+
+    Parameters
+    ----------
+    name : str
+        A name in :data:`FUNCTION_NAMES`.
+    """
     return FUNCTION_NAMES.index(name)
 
 
 def uses_coupling(name: str) -> bool:
-    """True for the functions that switch on the pair flag ``F_en``, such as (10) and (11)."""
+    """True for the functions that switch on the pair flag ``F_en``, such as (10) and (11).
+
+    Parameters
+    ----------
+    name : str
+        A name in :data:`FUNCTION_NAMES`.
+    """
     return FUNCTIONS[code(name)].couples

@@ -19,6 +19,12 @@ MODELS: dict[str, str] = {
 
 
 def vehicle_model(params: Any):
-    """The :class:`~tmem.model.base.VehicleModel` for a scenario's ``[model]`` table (by its ``kind``)."""
+    """The :class:`~tmem.model.base.VehicleModel` for a scenario's ``[model]`` table (by its ``kind``).
+
+    Parameters
+    ----------
+    params
+        The validated ``[model]`` table, e.g. :class:`~tmem.scenario.tables.LinearModelParams`.
+    """
     module, name = MODELS[params.kind].split(":")
     return getattr(import_module(module), name)(params)

@@ -66,16 +66,37 @@ class VehicleModel(ABC):
 
     @abstractmethod
     def step_params(self, dt: float) -> NamedTuple:
-        """The record the compiled :attr:`step` needs to advance one step of ``dt`` seconds."""
+        """The record the compiled :attr:`step` needs to advance one step of ``dt`` seconds.
+
+        Parameters
+        ----------
+        dt : float
+            The time step (s).
+        """
 
     def position(self, state: np.ndarray) -> np.ndarray:
-        """Positions (m) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``."""
+        """Positions (m) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``.
+
+        Parameters
+        ----------
+        state : ndarray, shape (..., axes, n_state)
+        """
         return state[..., self.POSITION]
 
     def velocity(self, state: np.ndarray) -> np.ndarray:
-        """Velocities (m/s) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``."""
+        """Velocities (m/s) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``.
+
+        Parameters
+        ----------
+        state : ndarray, shape (..., axes, n_state)
+        """
         return state[..., self.VELOCITY]
 
     def tilt(self, state: np.ndarray) -> np.ndarray:
-        """Tilts (rad) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``."""
+        """Tilts (rad) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``.
+
+        Parameters
+        ----------
+        state : ndarray, shape (..., axes, n_state)
+        """
         return state[..., self.TILT]

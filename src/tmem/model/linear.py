@@ -95,7 +95,18 @@ class HoldStep(NamedTuple):
 
 @numba.njit(cache=True, inline="always")
 def hold_step(ad, bd, x0, x1, x2, x3, u):
-    """One zero-order-hold step of one axis, ``Ad x + Bd U``, as four numbers."""
+    """One zero-order-hold step of one axis, ``Ad x + Bd U``, as four numbers.
+
+    Parameters
+    ----------
+    ad : ndarray, shape (4, 4)
+    bd : ndarray, shape (4,)
+        ``(Ad, Bd)`` of :func:`zero_order_hold`.
+    x0, x1, x2, x3 : float
+        The state ``(P, V, phi, omega)`` (m, m/s, rad, rad/s).
+    u : float
+        The tilt set-point ``U`` held over the step (rad).
+    """
     return (
         ad[0, 0] * x0 + ad[0, 1] * x1 + ad[0, 2] * x2 + ad[0, 3] * x3 + bd[0] * u,
         ad[1, 0] * x0 + ad[1, 1] * x1 + ad[1, 2] * x2 + ad[1, 3] * x3 + bd[1] * u,
@@ -106,7 +117,23 @@ def hold_step(ad, bd, x0, x1, x2, x3, u):
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def step_zero_order_hold(x, u, i, scale, params, n_axes):
-    """Advance agent ``i`` of ``x`` (agents, axes, 4) over one step with ``U = u[i] * scale`` held (2)."""
+    """Advance agent ``i`` of ``x`` (agents, axes, 4) over one step with ``U = u[i] * scale`` held (2).
+
+    Parameters
+    ----------
+    x : ndarray, shape (agents, axes, 4)
+        States, changed in place.
+    u : ndarray, shape (agents, axes)
+        Summed tilt set-points (rad).
+    i : int
+        The agent.
+    scale : float
+        Saturation factor of ``u[i]`` (:func:`tmem.engine.stages.tilt_scale`).
+    params : HoldStep
+        ``(Ad, Bd)`` for the time step.
+    n_axes : int
+        Number of axes.
+    """
     for a in range(n_axes):
         x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3] = hold_step(
             params.ad, params.bd, x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3], u[i, a] * scale
@@ -128,5 +155,11 @@ class LinearModel(VehicleModel):
         return state_matrices(p.kp, p.kd, p.g)
 
     def step_params(self, dt: float) -> HoldStep:
-        """``(Ad, Bd)`` of the exact zero-order hold over ``dt``."""
+        """``(Ad, Bd)`` of the exact zero-order hold over ``dt``.
+
+        Parameters
+        ----------
+        dt : float
+            The time step (s).
+        """
         return HoldStep(*zero_order_hold(*self.linearisation(), dt))

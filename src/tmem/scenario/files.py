@@ -74,12 +74,24 @@ def _explain(error: dict) -> str:
 
 
 def describe(exc: ValidationError) -> str:
-    """A validation failure as one line: each error's field and reason, in the file's words."""
+    """A validation failure as one line: each error's field and reason, in the file's words.
+
+    Parameters
+    ----------
+    exc : pydantic.ValidationError
+        The failure of validating a scenario.
+    """
     return "; ".join(_explain(e) for e in exc.errors())
 
 
 def from_dict(data: dict) -> Scenario:
-    """Validate a scenario given as nested dicts; raise :class:`ScenarioError`."""
+    """Validate a scenario given as nested dicts; raise :class:`ScenarioError`.
+
+    Parameters
+    ----------
+    data : dict
+        The tables of a scenario file, as ``tomllib`` reads them.
+    """
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
@@ -87,7 +99,17 @@ def from_dict(data: dict) -> Scenario:
 
 
 def read_text(path: Path, what: str, error: type[ValueError]) -> str:
-    """The text of the ``what`` file at ``path``; a missing or unreadable file raises ``error`` in one line."""
+    """The text of the ``what`` file at ``path``; a missing or unreadable file raises ``error`` in one line.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    what : str
+        What the file holds, for the message (``"scenario"``, ``"sweep"``).
+    error : type of ValueError
+        The exception raised with the one-line message.
+    """
     try:
         return path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -99,13 +121,27 @@ def read_text(path: Path, what: str, error: type[ValueError]) -> str:
 
 
 def load(path: str | Path) -> Scenario:
-    """Read and validate a scenario TOML file; raise :class:`ScenarioError`."""
+    """Read and validate a scenario TOML file; raise :class:`ScenarioError`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scenario file.
+    """
     path = Path(path)
     return loads(read_text(path, "scenario", ScenarioError), source=str(path))
 
 
 def loads(text: str, source: str = "<scenario>") -> Scenario:
-    """Parse and validate scenario TOML text; raise :class:`ScenarioError`."""
+    """Parse and validate scenario TOML text; raise :class:`ScenarioError`.
+
+    Parameters
+    ----------
+    text : str
+        The scenario, in TOML.
+    source : str
+        Where the text came from, at the start of an error message.
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -121,6 +157,13 @@ def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
 
     Example: ``with_changes(s, {"interaction.function": "repulsion", "agents[1].velocity": 2.0})``.
     A whole list can be replaced too: ``{"agents": [{"position": 0.0}, {"position": 50.0}]}``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario to copy.
+    changes : dict
+        New values by dotted path (``"table.key"``, ``"agents[i].key"``).
     """
     data = scenario.model_dump()
     for path, value in changes.items():
@@ -138,7 +181,13 @@ def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
 
 
 def preset(name: str) -> Scenario:
-    """One of the shipped scenarios: the paper's ``fig5``, ``fig7``, ``fig9`` or ``repulsion``."""
+    """One of the shipped scenarios: the paper's ``fig5``, ``fig7``, ``fig9`` or ``repulsion``.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`PRESETS`.
+    """
     if name not in PRESETS:
         raise ScenarioError(f"preset: unknown name {name!r}; choose from {', '.join(PRESETS)}")
     text = resources.files("tmem").joinpath("presets", f"{name}.toml").read_text(encoding="utf-8")

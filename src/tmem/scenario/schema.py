@@ -68,6 +68,7 @@ class Scenario(StrictModel):
 
     @property
     def n_agents(self) -> int:
+        """Number of agents: of the swarm, of the formation, or the ``[[agents]]`` listed."""
         if self.swarm is not None:
             return self.swarm.n
         if self.formation is not None and self.formation.kind != "edges":

@@ -22,7 +22,15 @@ class ScenarioError(ValueError):
 
 
 class FieldError(ValueError):
-    """Raised by a cross-field check to name the field at fault, relative to its table."""
+    """Raised by a cross-field check to name the field at fault, relative to its table.
+
+    Parameters
+    ----------
+    field : str
+        The field at fault, relative to its table (``"d_t"``).
+    reason : str
+        Why, in one line.
+    """
 
     def __init__(self, field: str, reason: str):
         super().__init__(reason)
@@ -31,6 +39,8 @@ class FieldError(ValueError):
 
 
 class StrictModel(BaseModel):
+    """Base of the scenario tables: unknown keys, non-finite numbers and quiet coercions refused."""
+
     # strict: no quiet coercion of true to 1 or "6.0" to 6.0.
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
@@ -123,7 +133,13 @@ class SimulationParams(StrictModel):
         return self.step_of(self.duration)
 
     def step_of(self, time: float) -> int:
-        """The step at which something due at ``time`` (s) happens: the nearest whole step."""
+        """The step at which something due at ``time`` (s) happens: the nearest whole step.
+
+        Parameters
+        ----------
+        time : float
+            Time from the start of the run (s).
+        """
         return int(round(time / self.dt))
 
     @model_validator(mode="after")

@@ -36,7 +36,15 @@ MAX_LISTED = 10
 
 
 def settings(table: pd.DataFrame, sweep: Sweep) -> list[tuple[str, pd.DataFrame]]:
-    """The table split by setting, each with a label such as ``interaction.function = improved``."""
+    """The table split by setting, each with a label such as ``interaction.function = improved``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        One row per case (:func:`tmem.sweep.tasks.row`).
+    sweep : Sweep
+        The sweep; its :attr:`~tmem.sweep.spec.Sweep.settings` name the columns to group by.
+    """
     columns = [c for c in sweep.settings if c in table]
     if not columns:
         return [("all cases", table)]
@@ -45,13 +53,30 @@ def settings(table: pd.DataFrame, sweep: Sweep) -> list[tuple[str, pd.DataFrame]
 
 
 def uncouple_command_time(sweep: Sweep) -> float | None:
-    """When the base scenario commands its pair to uncouple, if it does."""
+    """When the base scenario commands its pair to uncouple, if it does.
+
+    Parameters
+    ----------
+    sweep : Sweep
+        The sweep whose base scenario is read.
+
+    Returns
+    -------
+    float or None
+        The first uncouple command's time (s).
+    """
     times = [c.time for c in sweep.base.commands if c.action == "uncouple"]
     return min(times) if times else None
 
 
 def rms_statistics(values: pd.Series) -> dict:
-    """Mean, standard deviation, median, percentiles and extremes of the finite values."""
+    """Mean, standard deviation, median, percentiles and extremes of the finite values.
+
+    Parameters
+    ----------
+    values : pandas.Series
+        A metric over cases, such as ``rms_change_percent``.
+    """
     v = values.to_numpy(dtype=float)
     v = v[np.isfinite(v)]
     if not v.size:
@@ -63,7 +88,15 @@ def rms_statistics(values: pd.Series) -> dict:
 
 
 def coupling_statistics(group: pd.DataFrame, command_time: float | None) -> dict:
-    """Shares coupled and uncoupled (percent), median coupling time and uncoupling delay (s)."""
+    """Shares coupled and uncoupled (percent), median coupling time and uncoupling delay (s).
+
+    Parameters
+    ----------
+    group : pandas.DataFrame
+        The rows of one setting.
+    command_time : float or None
+        Time of the uncouple command (s), from which the delay counts.
+    """
     ok = group[group["error"].isna()]
     coupled = ok["coupled"].astype(bool) if "coupled" in ok else ok["couple_time"].notna()
     stats = {"n": len(ok), "coupled_percent": 100.0 * coupled.mean() if len(ok) else np.nan}
@@ -171,7 +204,17 @@ def _figures(groups: list[tuple[str, pd.DataFrame]], table: pd.DataFrame, sweep:
 
 
 def write_report(table: pd.DataFrame, sweep: Sweep, out: str | Path) -> Path:
-    """Write ``out/summary.md`` and the figures for the complete ``table``; return the summary's path."""
+    """Write ``out/summary.md`` and the figures for the complete ``table``; return the summary's path.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        One row per case, every case done.
+    sweep : Sweep
+        The sweep the table belongs to.
+    out : str or Path
+        The sweep's output directory.
+    """
     out = Path(out)
     metrics = sweep.spec.metrics
     groups = settings(table, sweep)

@@ -51,6 +51,13 @@ class SweepInterrupted(Exception):
     Raised on Ctrl-C, and when the cluster lost tasks (a scheduler gone, a
     connection closed): their cases have no rows and run when the sweep is
     started again.
+
+    Parameters
+    ----------
+    done, total : int
+        Cases saved, and cases of the sweep.
+    why : str
+        What stopped it, at the start of the message.
     """
 
     def __init__(self, done: int, total: int, why: str = "interrupted"):
@@ -76,7 +83,15 @@ def _takes_signals() -> bool:
 
 @contextmanager
 def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
-    """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes."""
+    """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes.
+
+    Parameters
+    ----------
+    scheduler : str or None
+        Address of an existing Dask scheduler; ``None`` starts a local cluster.
+    workers : int or None
+        Worker processes of the local cluster; ``None``: one per core.
+    """
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
@@ -152,6 +167,8 @@ def run_sweep(
     scheduler
         Address of an existing Dask scheduler (``tcp://host:8786``); by
         default a local cluster of ``workers`` processes (all cores).
+    workers
+        Worker processes of the local cluster; ``None``: one per core.
     progress
         Called as ``progress(cases_done, cases_total)`` as tasks finish.
 

@@ -115,7 +115,15 @@ class Distribution(StrictModel):
         return self
 
     def draw(self, rng: np.random.Generator, n: int) -> list:
-        """``n`` values (Python numbers or the listed choices)."""
+        """``n`` values (Python numbers or the listed choices).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The sweep's generator, seeded by its ``seed``.
+        n : int
+            How many values.
+        """
         if self.uniform is not None:
             return rng.uniform(*self.uniform, size=n).tolist()
         if self.loguniform is not None:
@@ -195,6 +203,7 @@ class Sweep:
 
     @property
     def name(self) -> str:
+        """The sweep file's ``name``, else its file name without ``.toml``."""
         return self.spec.name or Path(self.source).stem
 
     @property
@@ -212,6 +221,7 @@ class Sweep:
 
     @property
     def n_cases(self) -> int:
+        """Number of cases: explicit cases times grid points times random draws."""
         return self.spec.n_cases
 
     def _settings(self) -> list[dict[str, Any]]:
@@ -271,7 +281,17 @@ def _dotted(table: dict, prefix: str = "") -> dict:
 
 
 def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = None) -> Sweep:
-    """Parse and check a sweep given as TOML text; ``directory`` anchors a relative ``base`` path."""
+    """Parse and check a sweep given as TOML text; ``directory`` anchors a relative ``base`` path.
+
+    Parameters
+    ----------
+    text : str
+        The sweep, in TOML.
+    source : str
+        Where the text came from, at the start of an error message.
+    directory : Path or None
+        Where a relative ``base`` file is found; default: the current directory.
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -304,6 +324,12 @@ def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = Non
 
 
 def load_sweep(path: str | Path) -> Sweep:
-    """Read and check a sweep file; raise :class:`SweepError`."""
+    """Read and check a sweep file; raise :class:`SweepError`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The sweep file; a relative ``base`` is found beside it.
+    """
     path = Path(path)
     return loads_sweep(read_text(path, "sweep", SweepError), source=str(path), directory=path.parent)

@@ -35,7 +35,15 @@ PARTS = "parts"
 
 
 class ResultStore:
-    """The rows of one sweep in its output directory; see the module docstring."""
+    """The rows of one sweep in its output directory; see the module docstring.
+
+    Parameters
+    ----------
+    out : Path
+        The sweep's output directory.
+    sweep : Sweep
+        The sweep whose rows it keeps.
+    """
 
     def __init__(self, out: Path, sweep: Sweep):
         self.out = out
@@ -44,7 +52,16 @@ class ResultStore:
 
     @classmethod
     def open(cls, out: str | Path, sweep: Sweep) -> "ResultStore":
-        """Open ``out`` for ``sweep``: new, empty, or holding this sweep's results so far."""
+        """Open ``out`` for ``sweep``: new, empty, or holding this sweep's results so far.
+
+        Parameters
+        ----------
+        out : str or Path
+            The sweep's output directory; refused with :class:`~tmem.io.OutputError` if it holds
+            anything else.
+        sweep : Sweep
+            The sweep whose rows it keeps.
+        """
         out = Path(out)
         _check_directory(out, sweep)
         store = cls(out, sweep)
@@ -72,7 +89,13 @@ class ResultStore:
         return done
 
     def add(self, rows: list[dict]) -> None:
-        """Write ``rows`` as a new part (whole or not at all)."""
+        """Write ``rows`` as a new part (whole or not at all).
+
+        Parameters
+        ----------
+        rows : list of dict
+            Rows of finished cases (:func:`tmem.sweep.tasks.row`).
+        """
         if not rows:
             return
         frame = self._frame(rows)

@@ -41,7 +41,15 @@ def _shared(case: Case) -> dict[str, Any]:
 
 
 def batchable(scenario: Scenario, metrics: tuple[str, ...]) -> bool:
-    """Whether cases of ``scenario`` run as one batch: the paper's case, and only the batch's metrics kept."""
+    """Whether cases of ``scenario`` run as one batch: the paper's case, and only the batch's metrics kept.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario the cases share.
+    metrics : tuple of str
+        The metrics kept in each row.
+    """
     return unsupported(scenario) is None and set(metrics) <= set(SCALAR_METRICS)
 
 
@@ -51,6 +59,17 @@ def plan_chunks(base: Scenario, cases: Iterable[Case], metrics: tuple[str, ...],
     ``size`` is the sweep's ``batch``; by default :data:`BATCH_CHUNK` cases
     where a group runs as a batch and :data:`SINGLE_CHUNK` where its cases
     run one by one (so that they spread over the workers).
+
+    Parameters
+    ----------
+    base : Scenario
+        The sweep's base scenario.
+    cases : list of Case
+        The cases, each a set of changes to ``base``.
+    metrics : tuple of str
+        The metrics kept in each row (the sweep file's ``metrics``).
+    size : int or None
+        Cases per chunk; ``None``: as above.
     """
     groups: dict[str, list[Case]] = {}
     for case in cases:
@@ -80,12 +99,33 @@ def _value(summary: dict, metric: str) -> Any:
 
 
 def one_line(exc: BaseException) -> str:
-    """An exception as one line: its class and its message with whitespace folded."""
+    """An exception as one line: its class and its message with whitespace folded.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception a case raised.
+    """
     message = " ".join(str(exc).split())
     return f"{exc.__class__.__name__}: {message}" if message else exc.__class__.__name__
 
 
 def row(case: Case, metrics: tuple[str, ...], values: dict | None, error: str | None, seconds: float) -> dict:
+    """One case's row: its number, its changes, the metrics, the error and the compute time.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    metrics : tuple of str
+        The metrics kept.
+    values : dict or None
+        Each metric's value; ``None`` for a case that failed (every metric ``None``).
+    error : str or None
+        Why the case failed (:func:`one_line`), or ``None``.
+    seconds : float
+        Compute time of the case (s).
+    """
     row = {"case": case.index, **case.changes}
     row.update({m: None if values is None else values[m] for m in metrics})
     row["error"] = error
@@ -123,7 +163,17 @@ def _python(value: np.generic) -> Any:
 
 
 def run_chunk(base: Scenario, cases: list[Case], metrics: tuple[str, ...]) -> list[dict]:
-    """The rows of ``cases`` (one chunk of :func:`plan_chunks`), in order."""
+    """The rows of ``cases`` (one chunk of :func:`plan_chunks`), in order.
+
+    Parameters
+    ----------
+    base : Scenario
+        The sweep's base scenario.
+    cases : list of Case
+        The cases, each a set of changes to ``base``.
+    metrics : tuple of str
+        The metrics kept in each row (the sweep file's ``metrics``).
+    """
     try:
         scenario = with_changes(base, _shared(cases[0]))
     except ScenarioError:
