@@ -31,6 +31,7 @@ import numba
 import numpy as np
 
 from . import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from .space import into_box, nearest_image
 
 
 def all_pairs(active: np.ndarray) -> np.ndarray:
@@ -44,38 +45,6 @@ def all_pairs(active: np.ndarray) -> np.ndarray:
     flying = np.flatnonzero(active)
     first, second = np.triu_indices(len(flying), k=1)
     return np.stack([flying[first], flying[second]], axis=1).astype(np.uint32)
-
-
-@numba.njit(cache=True, inline="always")
-def nearest_image(delta, side):
-    """``delta`` taken to the nearest periodic image along an axis of length ``side`` (0: not periodic).
-
-    Parameters
-    ----------
-    delta : float
-        A difference of positions along the axis (m).
-    side : float
-        The box side along the axis (m); 0 on an open axis.
-    """
-    if abs(delta) < 0.25 * side:
-        return delta  # what the rounding below gives, without a division
-    if side > 0.0:
-        return delta - side * np.floor(delta / side + 0.5)
-    return delta
-
-
-@numba.njit(cache=True, inline="always")
-def into_box(position, side):
-    """``position`` taken into ``[0, side)`` along a periodic axis (``side > 0``).
-
-    Parameters
-    ----------
-    position : float
-        A position along the axis (m).
-    side : float
-        The box side along the axis (m).
-    """
-    return position - side * np.floor(position / side)
 
 
 @numba.njit(cache=True)

@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..neighbors import into_box
+from ..space import into_box
 from ..sensing import measure
 from .records import DONE, LISTS_STALE
 from .stages import apply_commands, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record, tilt_scale

@@ -26,7 +26,7 @@ import numpy as np
 from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
 from ..control import corrected_position
 from ..interaction.kernels import FunctionParams, pair_control
-from ..neighbors import nearest_image
+from ..space import nearest_image
 from .records import ADD, COUPLE, REMOVE
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
