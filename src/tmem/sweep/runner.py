@@ -8,7 +8,7 @@ same path: a :class:`dask.distributed.Client` and its futures.  A remote
 cluster's workers need tmem installed, in the same version.
 
 Nothing is lost when a sweep stops early: on Ctrl-C the rows received are
-written before :class:`SweepInterrupted` is raised; a killed worker's tasks
+written before :class:`SweepInterrupted` is raised (SIGTERM and SIGHUP alike); a killed worker's tasks
 are run again by Dask on the others; after a killed client, the parts on
 disk are whole; tasks the cluster loses (a scheduler gone, a connection
 closed) leave their cases without rows.  The same command then runs only
@@ -205,11 +205,13 @@ def run_sweep(
                             except Exception as exc:  # e.g. a worker killed again and again by this chunk
                                 waiting += [row(case, metrics, None, one_line(exc), None) for case in chunk]
                                 ran += len(chunk)
-                        if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS:
+                        if waiting and (len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS):
                             store.add(waiting)
                             waiting, last_flush = [], time.perf_counter()
                         if progress and ready:
                             progress(done + ran, sweep.n_cases)
+                    if ctrl_c.is_set():  # came as the last tasks finished: still a stop, not a finish
+                        raise KeyboardInterrupt
                     store.add(waiting)
                 except KeyboardInterrupt:
                     store.add(waiting)
