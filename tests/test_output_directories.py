@@ -339,3 +339,17 @@ def test_a_scheduler_error_writes_nothing(runner, tmp_path):
 def test_partial_names_stay_short_and_keep_the_suffix():
     name = partial_name("a" * 255 + ".gif", ".gif")
     assert len(name.encode()) < 255 and name.endswith(".gif") and f"tmem-partial-{os.getpid()}-" in name
+
+
+@pytest.mark.parametrize("out", ["x" * 300, "new/" + "y" * 256 + "/out"])
+def test_a_name_too_long_is_refused_before_anything_runs(runner, tmp_path, pair_2d, monkeypatch, out):
+    monkeypatch.chdir(tmp_path)
+    code, stderr, _ = invoke(runner, "run", EXAMPLES / "repulsion.toml", "--out", out)
+    one_line_refusal(code, stderr)
+    assert "has a name longer than 255 bytes" in stderr
+    run = tmp_path / "pair"
+    assert invoke(runner, "run", pair_2d, "--out", run)[0] == 0
+    code, stderr, _ = invoke(runner, "animate", run, "--out", out + ".gif")
+    one_line_refusal(code, stderr)
+    assert "has a name longer than 255 bytes" in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pair"]

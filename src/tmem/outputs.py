@@ -77,6 +77,8 @@ COMMANDS = ("run", "paper", "sweep", "animate")
 
 #: Characters of the destination's name kept in a temporary name (names stay under 255 bytes).
 _NAME_KEPT = 180
+#: The longest name of a file or folder (bytes) on common file systems.
+_NAME_MAX = 255
 _PARTIAL = re.compile(r"\.(?P<name>.*)\.tmem-partial-(?P<pid>[0-9]{1,10})-(?P<tag>[0-9a-f]{8})(?:\.[A-Za-z0-9]{1,10})?", re.S)
 #: Entries of an output directory that are tmem's bookkeeping, not its products.
 _BOOKKEEPING = frozenset({MANIFEST, LOCK})
@@ -291,6 +293,25 @@ def check_directory(out: str | Path, command: str, adopt: Callable[[Path], bool]
     manifest that the command recognises as its own (a sweep's, cut short).
     """
     out = Path(out)
+    try:
+        return _check_directory(out, command, adopt)
+    except OutputError:
+        raise
+    except OSError as exc:  # a name too long, a folder that cannot be searched
+        raise _refuse(out, f"cannot be used ({exc.strerror or exc})") from None
+
+
+def _too_long(path: Path) -> str | None:
+    """The first component of ``path`` longer than file systems allow (255 bytes), if any."""
+    for part in path.parts:
+        if len(os.fsencode(part)) > _NAME_MAX:
+            return part
+    return None
+
+
+def _check_directory(out: Path, command: str, adopt: Callable[[Path], bool] | None) -> Path:
+    if _too_long(out):
+        raise _refuse(out, f"has a name longer than {_NAME_MAX} bytes")
     if out.is_symlink():
         raise _refuse(out, "is a symbolic link; give the directory itself")
     if out.exists() and not out.is_dir():
@@ -475,6 +496,17 @@ def check_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out ")
     """Refuse a file ``out`` that may not be written: a directory, a link, or a file without ``mark``."""
     out = Path(out)
     where = f"{label}{out}"
+    try:
+        return _check_file(out, mark, where)
+    except OutputError:
+        raise
+    except OSError as exc:  # a name too long, a folder that cannot be searched
+        raise OutputError(f"{where}: cannot be used ({exc.strerror or exc})") from None
+
+
+def _check_file(out: Path, mark: str, where: str) -> Path:
+    if _too_long(out):
+        raise OutputError(f"{where}: has a name longer than {_NAME_MAX} bytes")
     if out.is_symlink():
         raise OutputError(f"{where}: is a symbolic link; give the file itself")
     if out.is_dir():
