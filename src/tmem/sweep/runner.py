@@ -81,7 +81,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
 
     if scheduler:
         try:
-            client = Client(scheduler, timeout="20s")
+            client = Client(scheduler, timeout="20s", set_as_default=False)  # a failed one must not linger as the default
         except (OSError, TimeoutError, ValueError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({one_line(exc)})") from None
         try:
@@ -106,7 +106,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
     finally:
         if main_thread:
             signal.signal(signal.SIGINT, interrupt)
-    client = Client(cluster)
+    client = Client(cluster, set_as_default=False)
     try:
         yield client
     finally:
@@ -187,7 +187,7 @@ def run_sweep(
                 base = client.scatter(sweep.base, broadcast=True)
                 chunks = plan_chunks(sweep.base, todo, metrics, sweep.spec.batch)
                 futures = {client.submit(run_chunk, base, chunk, metrics, pure=False): chunk for chunk in chunks}
-                finished = as_completed(futures)
+                finished = as_completed(futures, loop=client.loop)
                 try:
                     while not finished.is_empty():
                         if ctrl_c.is_set():
