@@ -72,16 +72,18 @@ MANIFEST = ".tmem-output.json"
 LOCK = ".tmem-lock"
 #: The mark of a file written by ``tmem animate`` (a GIF comment, MP4 metadata).
 ANIMATE_MARK = "written by tmem animate"
-#: Commands that write outputs, as their manifests name them.
-COMMANDS = ("run", "paper", "sweep", "animate")
+#: Commands that write output directories, as their manifests name them.
+COMMANDS = ("run", "paper", "sweep")
 
-#: Characters of the destination's name kept in a temporary name (names stay under 255 bytes).
+#: Bytes of the destination's name kept in a temporary name (names stay under 255 bytes).
 _NAME_KEPT = 180
 #: The longest name of a file or folder (bytes) on common file systems.
 _NAME_MAX = 255
 _PARTIAL = re.compile(r"\.(?P<name>.*)\.tmem-partial-(?P<pid>[0-9]{1,10})-(?P<tag>[0-9a-f]{8})(?:\.[A-Za-z0-9]{1,10})?", re.S)
 #: Entries of an output directory that are tmem's bookkeeping, not its products.
 _BOOKKEEPING = frozenset({MANIFEST, LOCK})
+#: The largest manifest read (bytes).
+_MANIFEST_MAX = 1 << 20
 #: Names shown in a message before "and N more".
 _SHOWN = 6
 
@@ -100,7 +102,8 @@ def partial_name(name: str, suffix: str = "") -> str:
     ``suffix`` (such as ``.gif``) is kept at the end so that writers which
     choose the format by the suffix still do.
     """
-    return f".{name[:_NAME_KEPT]}.tmem-partial-{os.getpid()}-{secrets.token_hex(4)}{suffix}"
+    kept = os.fsdecode(os.fsencode(name)[:_NAME_KEPT])
+    return f".{kept}.tmem-partial-{os.getpid()}-{secrets.token_hex(4)}{suffix}"
 
 
 def _partial_owner(name: str) -> int | None:
@@ -232,10 +235,12 @@ def _read_manifest(directory: Path) -> Manifest | None:
             return Manifest("sweep", None)
         return None
     try:
+        if path.is_symlink() or not path.is_file() or path.stat().st_size > _MANIFEST_MAX:
+            raise ValueError  # a FIFO, a device, or too big to be ours: not read
         data = json.loads(path.read_text(encoding="utf-8"))
         command = data["command"]
         files = data.get("files")
-        if command not in COMMANDS or path.is_symlink():
+        if command not in COMMANDS:
             raise ValueError
         if files is not None:
             if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
