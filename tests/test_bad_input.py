@@ -198,7 +198,7 @@ def test_output_directory_with_other_files_is_not_touched(tmp_path, runner, mark
         (out / marker).write_text("{}")
     result = runner.invoke(app, ["run", str(scenario), "--out", str(out)])
     assert result.exit_code == 2
-    assert "did not write" in result.stderr
+    assert "holds files that are not marked as a tmem output (chapter1.tex" in result.stderr
     assert (out / "chapter1.tex").read_text() == "precious"
 
 
@@ -229,12 +229,10 @@ def test_output_symlink_is_refused(tmp_path, runner):
 
 
 def test_unwritable_output_gives_one_line_and_leaves_nothing(tmp_path, runner, monkeypatch):
-    import tempfile
-
     def full(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(tempfile, "mkdtemp", full)
+    monkeypatch.setattr("tmem.outputs._new_partial_directory", full)
     out = tmp_path / "new" / "deeper" / "out"
     result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", str(out)])
     assert result.exit_code == 2 and "No space left" in result.stderr

@@ -29,8 +29,11 @@ def fig9_run(tmp_path_factory):
 
 def test_run_writes_the_promised_files(fig9_run):
     assert sorted(p.name for p in fig9_run.iterdir()) == [
-        "distance.png", "summary.json", "trajectory.nc", "velocity.png",
+        ".tmem-output.json", "distance.png", "summary.json", "trajectory.nc", "velocity.png",
     ]  # fmt: skip
+    manifest = json.loads((fig9_run / ".tmem-output.json").read_text())
+    assert manifest["command"] == "run"
+    assert manifest["files"] == ["distance.png", "summary.json", "trajectory.nc", "velocity.png"]
     for png in ("distance.png", "velocity.png"):
         assert (fig9_run / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -73,11 +76,11 @@ def test_rerun_replaces_an_earlier_run(tmp_path):
     out = tmp_path / "o"
     runner = CliRunner()
     assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
-    (out / "formation.png").write_bytes(b"from an earlier run")  # a tmem file this run does not write
-    (out / "summary.json").write_text("{}")
+    (out / "summary.json").write_text("{}")  # a file the earlier run wrote, changed
+    (out / "velocity.png").unlink()  # and one removed
     assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
-    assert not (out / "formation.png").exists()
     assert json.loads((out / "summary.json").read_text())["function"] == "repulsion"
+    assert (out / "velocity.png").exists()
     assert [p.name for p in tmp_path.iterdir()] == ["o"]  # no temporary directory left behind
 
 
@@ -85,7 +88,7 @@ def test_paper_command_writes_three_runs_and_the_report(tmp_path):
     out = tmp_path / "paper"
     result = CliRunner().invoke(app, ["paper", "--out", str(out)])
     assert result.exit_code == 0, result.output
-    assert sorted(p.name for p in out.iterdir()) == ["fig5", "fig7", "fig9", "report.md"]
+    assert sorted(p.name for p in out.iterdir()) == [".tmem-output.json", "fig5", "fig7", "fig9", "report.md"]
     report = (out / "report.md").read_text()
     for name in ("fig5", "fig7", "fig9"):
         s = json.loads((out / name / "summary.json").read_text())

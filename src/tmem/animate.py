@@ -37,6 +37,9 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from PIL import Image
 
+from . import __version__
+from .outputs import ANIMATE_MARK, check_file, replace_file
+
 #: Most agents drawn; larger runs are thinned evenly to this many.
 MAX_AGENTS_DRAWN = 3000
 #: Most agents drawn with their interaction circles.
@@ -135,12 +138,26 @@ class _CanvasPillowWriter(animation.PillowWriter):
             self._palette = rgb.quantize(method=Image.Quantize.FASTOCTREE)
         self._frames.append(rgb.quantize(palette=self._palette, dither=Image.Dither.NONE))
 
+    def finish(self) -> None:
+        self._frames[0].save(
+            self.outfile, format="GIF", save_all=True, append_images=self._frames[1:],
+            duration=int(1000 / self.fps), loop=0, comment=f"{ANIMATE_MARK} {__version__}".encode(),
+        )  # fmt: skip
+
 
 class _CanvasFFMpegWriter(animation.FFMpegWriter):
     """Matplotlib's ffmpeg writer, fed from the canvas as last drawn (raw RGBA)."""
 
     def grab_frame(self, **savefig_kwargs) -> None:
         self._proc.stdin.write(self.fig.canvas.buffer_rgba())
+
+
+def _abandon(writer: animation.AbstractMovieWriter) -> None:
+    """Stop a writer without writing the file (an ffmpeg process is ended)."""
+    process = getattr(writer, "_proc", None)
+    if process is not None:
+        process.kill()
+        process.wait()
 
 
 def _polyline(segments: np.ndarray) -> np.ndarray:
@@ -157,7 +174,7 @@ def _writer(out: Path, fps: float) -> animation.AbstractMovieWriter:
     if suffix == ".mp4":
         if not animation.writers.is_available("ffmpeg"):
             raise ValueError("animate: writing MP4 needs ffmpeg; write a .gif instead")
-        return _CanvasFFMpegWriter(fps=fps)
+        return _CanvasFFMpegWriter(fps=fps, metadata={"comment": f"{ANIMATE_MARK} {__version__}"})
     raise ValueError(f"animate: cannot write {out.name!r}; name a .gif or .mp4 file")
 
 
@@ -246,14 +263,20 @@ def animate(
     ValueError
         With a one-line message: no ``trajectory.nc``, a run that is not 2-D,
         no ``interaction.radius`` in the scenario, an output that is neither
-        ``.gif`` nor ``.mp4``, or MP4 without ffmpeg.
+        ``.gif`` nor ``.mp4``, or MP4 without ffmpeg; an ``out`` that
+        exists and was not written by ``animate`` (:func:`tmem.outputs.check_file`).
+
+    The file is written under a temporary name beside ``out`` and renamed
+    when complete: an interrupted animation leaves nothing at ``out``.
     """
     run_dir = Path(run_dir)
     if fps <= 0 or max_frames < 1 or dpi <= 0:
         raise ValueError("animate: fps, max_frames and dpi must be positive")
+    label = "--out " if out is not None else ""
     out = Path(out) if out is not None else (run_dir.parent if run_dir.suffix == ".nc" else run_dir) / "animation.gif"
     run = _load(run_dir, max_frames)
     writer = _writer(out, fps)
+    check_file(out, label=label)
 
     # Removed agents (inactive after having been active) stay as crosses where last seen active.
     frame = np.arange(len(run.time))[:, None]
@@ -266,21 +289,26 @@ def animate(
     ax = fig.axes[0]
     background = fig.canvas.copy_from_bbox(fig.bbox)
     draw_dashed = np.count_nonzero(run.flag == 0, axis=1).max(initial=0) <= MAX_DASHED_EDGES
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with writer.saving(fig, str(out), dpi):
-        for f in range(len(run.time)):
-            ends = np.stack([run.pos[f, run.col_i], run.pos[f, run.col_j]], axis=1)  # (edge, 2, 2)
-            flying = run.active[f, run.col_i] & run.active[f, run.col_j]
-            on = flying & (run.flag[f] == 1)
-            moving["coupled"].set_segments(ends[on])
-            moving["coupled"].set_array(np.linalg.norm(ends[on, 1] - ends[on, 0], axis=-1) / run.d_t[on] - 1)
-            moving["dashed"].set_data(*_polyline(ends[flying & (run.flag[f] == 0)] if draw_dashed else ends[:0]).T)
-            moving["circles"].set_offsets(shown[f])
-            moving["dots"].set_offsets(shown[f])
-            moving["crosses"].set_offsets(cross[f])
-            moving["clock"].set_text(f"t = {run.time[f]:.1f} s")
-            fig.canvas.restore_region(background)
-            for artist in moving.values():
-                ax.draw_artist(artist)
-            writer.grab_frame()
+    with replace_file(out, label=label) as tmp:
+        writer.setup(fig, str(tmp), dpi)
+        try:
+            for f in range(len(run.time)):
+                ends = np.stack([run.pos[f, run.col_i], run.pos[f, run.col_j]], axis=1)  # (edge, 2, 2)
+                flying = run.active[f, run.col_i] & run.active[f, run.col_j]
+                on = flying & (run.flag[f] == 1)
+                moving["coupled"].set_segments(ends[on])
+                moving["coupled"].set_array(np.linalg.norm(ends[on, 1] - ends[on, 0], axis=-1) / run.d_t[on] - 1)
+                moving["dashed"].set_data(*_polyline(ends[flying & (run.flag[f] == 0)] if draw_dashed else ends[:0]).T)
+                moving["circles"].set_offsets(shown[f])
+                moving["dots"].set_offsets(shown[f])
+                moving["crosses"].set_offsets(cross[f])
+                moving["clock"].set_text(f"t = {run.time[f]:.1f} s")
+                fig.canvas.restore_region(background)
+                for artist in moving.values():
+                    ax.draw_artist(artist)
+                writer.grab_frame()
+        except BaseException:
+            _abandon(writer)
+            raise
+        writer.finish()
     return out

@@ -216,6 +216,9 @@ def sweep_command(
 
 def main() -> None:
     """Entry point of the ``tmem`` console script."""
+    from .outputs import handle_termination
+
+    handle_termination()  # SIGTERM and SIGHUP as Ctrl-C: interrupted writes leave nothing behind
     try:
         app()
     except KeyboardInterrupt:

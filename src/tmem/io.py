@@ -2,19 +2,14 @@
 
 A run directory holds ``summary.json`` (:func:`tmem.metrics.summarize`),
 ``trajectory.nc`` (:func:`to_dataset`, NetCDF-4 via h5netcdf) and the figures
-of :mod:`tmem.plot`.  Directories are written next to their destination under
-a temporary name and moved into place only when complete, so an interrupted
-or failed run leaves no half-written output and never touches an older one.
+of :mod:`tmem.plot`, and the manifest ``.tmem-output.json``.  When a
+directory may be replaced, and how an interrupted run leaves nothing behind,
+is :mod:`tmem.outputs`'s.
 """
 
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import tempfile
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -22,19 +17,11 @@ import xarray as xr
 
 from . import __version__, metrics, plot
 from .engine import Trajectory
+from .outputs import OutputError, check_directory, replace_directory
+
+__all__ = ["OutputError", "check_output_directory", "to_dataset", "write_run", "write_run_files"]
 
 PAPER = "E. Heiss, A. Kozyr, O. Morozov, Formations Organization in Robotic Swarm Using the Thermal Motion Equivalent Method"
-
-#: Everything tmem writes into an output directory; a directory holding only these may be replaced.
-OUTPUT_FILES = frozenset(
-    {"summary.json", "trajectory.nc", "velocity.png", "distance.png", "formation.png", "animation.gif", "report.md"}
-)
-OUTPUT_DIRECTORIES = frozenset({"fig5", "fig7", "fig9"})
-
-
-class OutputError(ValueError):
-    """An output directory that cannot be written; the message is one line."""
-
 
 def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     """The recorded trajectory as an :class:`xarray.Dataset`.
@@ -47,11 +34,6 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     of the recorded agents over time.  Units are in each variable's
     attributes; the scenario (as TOML), the gains and the events are in the
     dataset's attributes.
-
-    Parameters
-    ----------
-    trajectory : Trajectory
-        A run (:func:`tmem.simulate`).
     """
     n_axes = trajectory.scenario.space.axes
     coords = {
@@ -95,106 +77,13 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _only_tmem_output(directory: Path) -> bool:
-    for entry in directory.iterdir():
-        if entry.is_symlink():
-            return False
-        if entry.is_dir():
-            if entry.name not in OUTPUT_DIRECTORIES or not _only_tmem_output(entry):
-                return False
-        elif entry.name not in OUTPUT_FILES:
-            return False
-    return True
-
-
 def check_output_directory(out: str | Path) -> Path:
-    """Refuse an ``out`` that tmem may not replace; return it as a Path.
-
-    Allowed: a path that does not exist yet (under directories or nothing), an
-    empty directory, or one holding nothing but what tmem writes.  Refused: a
-    file, a symbolic link, the current directory or one containing it, a
-    directory holding anything else, a path below a file.
-
-    Parameters
-    ----------
-    out : str or Path
-        The output directory asked for.
-    """
-    out = Path(out)
-    if out.is_symlink():
-        raise OutputError(f"--out {out}: is a symbolic link; give the directory itself")
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"--out {out}: exists and is not a directory")
-    resolved = out.resolve()
-    if resolved == Path.cwd().resolve() or resolved in Path.cwd().resolve().parents:
-        raise OutputError(f"--out {out}: is the current directory or contains it; give a new subdirectory")
-    for parent in resolved.parents:
-        if parent.exists() and not parent.is_dir():
-            raise OutputError(f"--out {out}: {parent} is a file, not a directory")
-    if out.is_dir() and not _only_tmem_output(out):
-        raise OutputError(f"--out {out}: holds files tmem did not write; choose another directory")
-    return out
-
-
-@contextmanager
-def atomic_directory(out: str | Path) -> Iterator[Path]:
-    """Yield a temporary directory that replaces ``out`` only if the block succeeds.
-
-    Parent directories made for it are removed again if the block fails.  File
-    system errors (no permission, disk full) become :class:`OutputError`.
-
-    Parameters
-    ----------
-    out : str or Path
-        The output directory, checked by :func:`check_output_directory`.
-    """
-    out = check_output_directory(out)
-    missing = [p for p in reversed(out.absolute().parents) if not p.exists()]
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    except OSError as exc:
-        _remove_made(missing)
-        raise OutputError(f"--out {out}: cannot be written ({exc.strerror or exc})") from None
-    try:
-        yield tmp
-        umask = os.umask(0)
-        os.umask(umask)
-        tmp.chmod(0o777 & ~umask)  # mkdtemp made it private
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
-    except BaseException as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        _remove_made(missing)
-        if isinstance(exc, OSError):
-            raise OutputError(f"--out {out}: cannot be written ({exc.strerror or exc})") from None
-        raise
-
-
-def _remove_made(directories: list[Path]) -> None:
-    for directory in reversed(directories):
-        try:
-            directory.rmdir()
-        except OSError:
-            return
+    """Refuse an ``out`` that ``tmem run`` may not replace (:func:`tmem.outputs.check_directory`); return it."""
+    return check_directory(out, "run")
 
 
 def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
-    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``.
-
-    Parameters
-    ----------
-    trajectory : Trajectory
-        A run (:func:`tmem.simulate`).
-    directory : Path
-        An existing directory.
-
-    Returns
-    -------
-    dict
-        The summary (:func:`tmem.metrics.summarize`).
-    """
+    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``."""
     summary = metrics.summarize(trajectory)
     (directory / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
     to_dataset(trajectory).to_netcdf(directory / "trajectory.nc", engine="h5netcdf")
@@ -203,14 +92,6 @@ def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
 
 
 def write_run(trajectory: Trajectory, out: str | Path) -> dict:
-    """Write a complete run directory at ``out`` (atomically) and return its summary.
-
-    Parameters
-    ----------
-    trajectory : Trajectory
-        A run (:func:`tmem.simulate`).
-    out : str or Path
-        The run directory (:func:`check_output_directory` says which may be replaced).
-    """
-    with atomic_directory(out) as tmp:
+    """Write a complete run directory at ``out`` (atomically) and return its summary."""
+    with replace_directory(out, "run") as tmp:
         return write_run_files(trajectory, tmp)

@@ -12,7 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .engine import Trajectory, simulate
-from .io import atomic_directory, write_run_files
+from .io import write_run_files
+from .outputs import replace_directory
 from .scenario import preset
 
 #: The uncouple command of Figs. 7 and 9 (s).
@@ -57,7 +58,7 @@ def run_paper(
     """
     summaries: dict[str, dict] = {}
     trajectories: dict[str, Trajectory] = {}
-    with atomic_directory(out) as tmp:
+    with replace_directory(out, "paper") as tmp:
         for name in PAPER:
 
             def step(done: int, total: int, name: str = name) -> None:

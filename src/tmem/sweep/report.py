@@ -27,6 +27,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from ..outputs import write_atomically  # noqa: E402
 from .spec import Sweep  # noqa: E402
 
 RMS = "rms_change_percent"
@@ -180,7 +181,7 @@ def _figures(groups: list[tuple[str, pd.DataFrame]], table: pd.DataFrame, sweep:
         ax.set_ylabel("cases")
     axes[-1, 0].set_xlabel("RMS velocity change (%)")
     fig.tight_layout()
-    fig.savefig(out / "rms_change_histogram.png", dpi=110)
+    write_atomically(out / "rms_change_histogram.png", lambda tmp: fig.savefig(tmp, dpi=110))
     plt.close(fig)
     names.append("rms_change_histogram.png")
     for path in sweep.parameters:
@@ -197,7 +198,7 @@ def _figures(groups: list[tuple[str, pd.DataFrame]], table: pd.DataFrame, sweep:
             ax.legend(fontsize=8, markerscale=4)
         fig.tight_layout()
         name = f"rms_change_vs_{path.replace('.', '_')}.png"
-        fig.savefig(out / name, dpi=110)
+        write_atomically(out / name, lambda tmp: fig.savefig(tmp, dpi=110))
         plt.close(fig)
         names.append(name)
     return ["## Figures", "", *[f"![{n}]({n})" for n in names], ""]
@@ -244,5 +245,5 @@ def write_report(table: pd.DataFrame, sweep: Sweep, out: str | Path) -> Path:
     if RMS in metrics and len(table) > len(failed):
         lines += _figures(groups, table, sweep, out)
     path = out / "summary.md"
-    path.write_text("\n".join(lines).rstrip() + "\n", encoding="utf-8")
+    write_atomically(path, lambda tmp: tmp.write_text("\n".join(lines).rstrip() + "\n", encoding="utf-8"))
     return path

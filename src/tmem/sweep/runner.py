@@ -8,7 +8,7 @@ same path: a :class:`dask.distributed.Client` and its futures.  A remote
 cluster's workers need tmem installed, in the same version.
 
 Nothing is lost when a sweep stops early: on Ctrl-C the rows received are
-written before :class:`SweepInterrupted` is raised; a killed worker's tasks
+written before :class:`SweepInterrupted` is raised (SIGTERM and SIGHUP alike); a killed worker's tasks
 are run again by Dask on the others; after a killed client, the parts on
 disk are whole; tasks the cluster loses (a scheduler gone, a connection
 closed) leave their cases without rows.  The same command then runs only
@@ -27,7 +27,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import CancelledError
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -96,7 +96,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
 
     if scheduler:
         try:
-            client = Client(scheduler, timeout="20s")
+            client = Client(scheduler, timeout="20s", set_as_default=False)  # a failed one must not linger as the default
         except (OSError, TimeoutError, ValueError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({one_line(exc)})") from None
         try:
@@ -121,7 +121,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
     finally:
         if main_thread:
             signal.signal(signal.SIGINT, interrupt)
-    client = Client(cluster)
+    client = Client(cluster, set_as_default=False)
     try:
         yield client
     finally:
@@ -131,22 +131,27 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
 
 @contextmanager
 def _ctrl_c_as_flag() -> Iterator[threading.Event]:
-    """While the sweep runs, Ctrl-C sets a flag that the collecting loop reads between tasks.
+    """While the sweep runs, Ctrl-C (and SIGTERM, SIGHUP) set a flag that the collecting loop reads between tasks.
 
     A KeyboardInterrupt raised at a random point inside Dask's client machinery
     leaves it half-stopped and logging tracebacks; read as a flag, Ctrl-C stops
     the sweep in order.  (Only the main thread can take signals; elsewhere the
-    flag is never set.)
+    flag is never set.  A signal set to be ignored stays ignored.)
     """
     flag = threading.Event()
     if not _takes_signals():
         yield flag
         return
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: flag.set())
+    previous = {}
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        signum = getattr(signal, name, None)
+        if signum is not None and signal.getsignal(signum) not in (signal.SIG_IGN, None):
+            previous[signum] = signal.signal(signum, lambda signum, frame: flag.set())
     try:
         yield flag
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def run_sweep(
@@ -176,54 +181,63 @@ def run_sweep(
     """
     started = time.perf_counter()
     out = Path(out)
-    store = ResultStore.open(out, sweep)
+    store = ResultStore.check(out, sweep)
     metrics = store.metrics
-    done_before = store.done_cases()
-    todo = [c for c in sweep.cases() if c.index not in done_before]
-    done = sweep.n_cases - len(todo)
-    ran = 0
-    if progress:
-        progress(done, sweep.n_cases)
-    if todo:
-        waiting: list[dict] = []
-        lost = ""
-        last_flush = -math.inf  # the first rows go to disk at once
-        with _ctrl_c_as_flag() as ctrl_c, dask_client(scheduler, workers) as client:
-            from dask.distributed import as_completed
+    with ExitStack() as held:
+        if store.exists:
+            held.enter_context(store.opened())  # the lock, before reading what is done
+        done_before = store.done_cases()
+        todo = [c for c in sweep.cases() if c.index not in done_before]
+        done = sweep.n_cases - len(todo)
+        ran = 0
+        if progress:
+            progress(done, sweep.n_cases)
+        if todo:
+            waiting: list[dict] = []
+            lost = ""
+            last_flush = -math.inf  # the first rows go to disk at once
+            with _ctrl_c_as_flag() as ctrl_c, dask_client(scheduler, workers) as client:
+                from dask.distributed import as_completed
 
-            base = client.scatter(sweep.base, broadcast=True)
-            chunks = plan_chunks(sweep.base, todo, metrics, sweep.spec.batch)
-            futures = {client.submit(run_chunk, base, chunk, metrics, pure=False): chunk for chunk in chunks}
-            finished = as_completed(futures)
-            try:
-                while not finished.is_empty():
-                    if ctrl_c.is_set():
+                if not store.exists:  # made only once the cluster answers: a bad --scheduler leaves nothing
+                    held.enter_context(store.opened())
+                base = client.scatter(sweep.base, broadcast=True)
+                chunks = plan_chunks(sweep.base, todo, metrics, sweep.spec.batch)
+                futures = {client.submit(run_chunk, base, chunk, metrics, pure=False): chunk for chunk in chunks}
+                finished = as_completed(futures, loop=client.loop)
+                try:
+                    while not finished.is_empty():
+                        if ctrl_c.is_set():
+                            raise KeyboardInterrupt
+                        ready = finished.next_batch(block=False)
+                        if not ready:
+                            time.sleep(POLL_SECONDS)
+                        for future in ready:
+                            chunk = futures.pop(future)
+                            try:
+                                waiting += future.result()
+                                ran += len(chunk)
+                            except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
+                                lost = f"{one_line(exc)} (from the cluster)"
+                            except Exception as exc:  # e.g. a worker killed again and again by this chunk
+                                waiting += [row(case, metrics, None, one_line(exc), None) for case in chunk]
+                                ran += len(chunk)
+                        if waiting and (len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS):
+                            store.add(waiting)
+                            waiting, last_flush = [], time.perf_counter()
+                        if progress and ready:
+                            progress(done + ran, sweep.n_cases)
+                    if ctrl_c.is_set():  # came as the last tasks finished: still a stop, not a finish
                         raise KeyboardInterrupt
-                    ready = finished.next_batch(block=False)
-                    if not ready:
-                        time.sleep(POLL_SECONDS)
-                    for future in ready:
-                        chunk = futures.pop(future)
-                        try:
-                            waiting += future.result()
-                            ran += len(chunk)
-                        except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
-                            lost = f"{one_line(exc)} (from the cluster)"
-                        except Exception as exc:  # e.g. a worker killed again and again by this chunk
-                            waiting += [row(case, metrics, None, one_line(exc), None) for case in chunk]
-                            ran += len(chunk)
-                    if len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS:
-                        store.add(waiting)
-                        waiting, last_flush = [], time.perf_counter()
-                    if progress and ready:
-                        progress(done + ran, sweep.n_cases)
-                store.add(waiting)
-            except KeyboardInterrupt:
-                store.add(waiting)
-                client.cancel(list(futures))
-                raise SweepInterrupted(done + ran, sweep.n_cases) from None
-        if lost:
-            raise SweepInterrupted(done + ran, sweep.n_cases, why=f"tasks lost, {lost}")
-    table = store.finish()
-    write_report(table, sweep, out)
+                    store.add(waiting)
+                except KeyboardInterrupt:
+                    store.add(waiting)
+                    client.cancel(list(futures))
+                    raise SweepInterrupted(done + ran, sweep.n_cases) from None
+            if lost:
+                raise SweepInterrupted(done + ran, sweep.n_cases, why=f"tasks lost, {lost}")
+        if not store.exists:  # a sweep of no cases
+            held.enter_context(store.opened())
+        table = store.finish()
+        write_report(table, sweep, out)
     return SweepOutcome(table=table, ran=ran, failed=int(table["error"].notna().sum()), seconds=time.perf_counter() - started)

@@ -13,37 +13,51 @@ The output directory of ``tmem sweep`` holds:
 
 Started again on the same directory with the same sweep, a run reads which
 cases are done from these files and runs only the others.  A directory
-holding another sweep's results is refused, not mixed with.
+holding another sweep's results is refused, not mixed with; one holding
+anything but a sweep's output too (:func:`tmem.outputs.check_directory`).
+
+The directory appears whole: ``sweep.toml``, ``sweep.json``, the manifest
+``.tmem-output.json`` and ``parts/`` are written into a temporary directory
+that is renamed into place (a directory holding only ``sweep.toml``, as an
+earlier tmem could leave when killed, is taken up again).  While a sweep
+writes, it holds the directory's lock (:func:`tmem.outputs.lock`); it removes
+what killed processes left (temporary parts, a temporary ``results.parquet``)
+when it takes the lock.
 """
 
 from __future__ import annotations
 
 import json
-import os
+import re
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
 import pyarrow.parquet as pq
 
 from .. import __version__
-from ..io import OutputError
+from ..outputs import (
+    MANIFEST,
+    OutputError,
+    check_directory,
+    create_directory,
+    lock,
+    mark_directory,
+    remove_leftovers,
+    write_atomically,
+)
 from .spec import Sweep
 
 RESULTS = "results.parquet"
 PARTS = "parts"
+#: Temporary files of an earlier tmem (no process id in the name), removed under the lock.
+_OLD_TEMPORARY = re.compile(r"\.(results\.parquet|part-[0-9]+-[0-9a-f]{8}\.parquet)\.[0-9a-f]{8}\.tmp")
 
 
 class ResultStore:
-    """The rows of one sweep in its output directory; see the module docstring.
-
-    Parameters
-    ----------
-    out : Path
-        The sweep's output directory.
-    sweep : Sweep
-        The sweep whose rows it keeps.
-    """
+    """The rows of one sweep in its output directory; see the module docstring."""
 
     def __init__(self, out: Path, sweep: Sweep):
         self.out = out
@@ -51,35 +65,62 @@ class ResultStore:
         self.metrics = tuple(sweep.spec.metrics)
 
     @classmethod
-    def open(cls, out: str | Path, sweep: Sweep) -> "ResultStore":
-        """Open ``out`` for ``sweep``: new, empty, or holding this sweep's results so far.
+    def check(cls, out: str | Path, sweep: Sweep) -> "ResultStore":
+        """The store of ``sweep`` at ``out``: new, empty, or holding this sweep's results so far.
 
-        Parameters
-        ----------
-        out : str or Path
-            The sweep's output directory; refused with :class:`~tmem.io.OutputError` if it holds
-            anything else.
-        sweep : Sweep
-            The sweep whose rows it keeps.
+        Reads only: nothing is written until :meth:`opened`.
         """
         out = Path(out)
-        _check_directory(out, sweep)
-        store = cls(out, sweep)
-        try:
-            (out / PARTS).mkdir(parents=True, exist_ok=True)
-            for stale in (out / PARTS).glob(".*.tmp"):  # a part whose writing was cut off
-                stale.unlink()
-            if not (out / "sweep.json").exists():
-                (out / "sweep.toml").write_text(sweep.text, encoding="utf-8")
-                identity = {"fingerprint": sweep.fingerprint, "cases": sweep.n_cases, "name": sweep.name, "tmem": __version__}
-                _write_atomically(out / "sweep.json", lambda tmp: tmp.write_text(json.dumps(identity, indent=2) + "\n"))
-        except OSError as exc:
-            raise OutputError(f"--out {out}: cannot be written ({exc.strerror or exc})") from None
-        return store
+        check_directory(out, "sweep", adopt=lambda directory: _only_a_first_sweep_toml(directory, sweep))
+        _check_identity(out, sweep)
+        return cls(out, sweep)
+
+    @property
+    def exists(self) -> bool:
+        """Whether the directory holds this sweep's output already (else :meth:`opened` makes it)."""
+        return (self.out / "sweep.toml").exists()
+
+    @contextmanager
+    def opened(self) -> Iterator["ResultStore"]:
+        """Hold the directory (made if new) for writing: its lock, the leftovers of killed runs removed."""
+        if not self.exists:
+            try:
+                with create_directory(self.out, "sweep") as tmp:
+                    self._write_identity(tmp)
+                    (tmp / PARTS).mkdir()
+            except FileExistsError:
+                pass  # another sweep made it meanwhile: take it up as an existing one, below
+            else:
+                with lock(self.out, "sweep"):
+                    yield self
+                return
+            type(self).check(self.out, self.sweep)
+        with lock(self.out, "sweep"):
+            try:
+                if not (self.out / "sweep.json").exists():  # left so by a killed earlier tmem
+                    self._write_identity(self.out)
+                if not (self.out / MANIFEST).exists():
+                    mark_directory(self.out, "sweep")
+                (self.out / PARTS).mkdir(exist_ok=True)
+                for folder in (self.out, self.out / PARTS):
+                    remove_leftovers(folder)
+                    for stale in folder.iterdir():
+                        if _OLD_TEMPORARY.fullmatch(stale.name):
+                            stale.unlink()
+            except OSError as exc:
+                raise OutputError(f"--out {self.out}: cannot be written ({exc.strerror or exc})") from None
+            yield self
+
+    def _write_identity(self, directory: Path) -> None:
+        sweep = self.sweep
+        write_atomically(directory / "sweep.toml", lambda tmp: tmp.write_text(sweep.text, encoding="utf-8"))
+        identity = {"fingerprint": sweep.fingerprint, "cases": sweep.n_cases, "name": sweep.name, "tmem": __version__}
+        write_atomically(directory / "sweep.json", lambda tmp: tmp.write_text(json.dumps(identity, indent=2) + "\n"))
 
     def _files(self) -> list[Path]:
         results = self.out / RESULTS
-        return ([results] if results.exists() else []) + sorted((self.out / PARTS).glob("part-*.parquet"))
+        parts = self.out / PARTS
+        return ([results] if results.exists() else []) + (sorted(parts.glob("part-*.parquet")) if parts.is_dir() else [])
 
     def done_cases(self) -> set[int]:
         """The cases with a row on disk."""
@@ -89,18 +130,12 @@ class ResultStore:
         return done
 
     def add(self, rows: list[dict]) -> None:
-        """Write ``rows`` as a new part (whole or not at all).
-
-        Parameters
-        ----------
-        rows : list of dict
-            Rows of finished cases (:func:`tmem.sweep.tasks.row`).
-        """
+        """Write ``rows`` as a new part (whole or not at all)."""
         if not rows:
             return
         frame = self._frame(rows)
         name = f"part-{int(frame['case'].min()):09d}-{uuid.uuid4().hex[:8]}.parquet"
-        _write_atomically(self.out / PARTS / name, lambda tmp: frame.to_parquet(tmp, index=False))
+        write_atomically(self.out / PARTS / name, lambda tmp: frame.to_parquet(tmp, index=False))
 
     def _frame(self, rows: list[dict]) -> pd.DataFrame:
         """Rows as a table with the same column types in every part."""
@@ -126,35 +161,40 @@ class ResultStore:
         frame = self.table()
         if len(frame) != self.sweep.n_cases:
             raise RuntimeError(f"finish: {len(frame)} of {self.sweep.n_cases} cases have rows")
-        _write_atomically(self.out / RESULTS, lambda tmp: frame.to_parquet(tmp, index=False))
-        for part in (self.out / PARTS).glob("part-*.parquet"):
-            part.unlink()
-        (self.out / PARTS).rmdir()
+        write_atomically(self.out / RESULTS, lambda tmp: frame.to_parquet(tmp, index=False))
+        parts = self.out / PARTS
+        if parts.is_dir():
+            for part in parts.glob("part-*.parquet"):
+                part.unlink()
+            remove_leftovers(parts)
+            parts.rmdir()
         return frame
 
 
-def _write_atomically(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.tmp")
+def _only_a_first_sweep_toml(out: Path, sweep: Sweep) -> bool:
+    """Whether ``out`` holds just this sweep's ``sweep.toml`` (and perhaps an empty ``parts/``).
+
+    An earlier tmem, killed between writing ``sweep.toml`` and ``sweep.json``,
+    left such a directory; it is this sweep's, started.
+    """
     try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+        if (out / "sweep.json").exists():
+            return False
+        names = {p.name for p in out.iterdir()}
+        if not names <= {"sweep.toml", PARTS} or "sweep.toml" not in names:
+            return False
+        if PARTS in names and ((out / PARTS).is_symlink() or any((out / PARTS).iterdir())):
+            return False
+        return (out / "sweep.toml").read_text(encoding="utf-8") == sweep.text
+    except (OSError, ValueError):
+        return False
 
 
-def _check_directory(out: Path, sweep: Sweep) -> None:
-    if out.is_symlink():
-        raise OutputError(f"--out {out}: is a symbolic link; give the directory itself")
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"--out {out}: exists and is not a directory")
-    for parent in out.absolute().parents:
-        if parent.exists() and not parent.is_dir():
-            raise OutputError(f"--out {out}: {parent} is a file, not a directory")
-    if not out.is_dir() or not any(out.iterdir()):
-        return
+def _check_identity(out: Path, sweep: Sweep) -> None:
+    """Refuse a sweep directory that holds another sweep's results."""
     identity = out / "sweep.json"
     if not identity.exists():
-        raise OutputError(f"--out {out}: holds files that are not a sweep's results; choose another directory")
+        return  # new or empty
     try:
         fingerprint = json.loads(identity.read_text(encoding="utf-8"))["fingerprint"]
     except (OSError, ValueError, KeyError, TypeError):

@@ -1,0 +1,304 @@
+"""Interrupted commands leave nothing partial: SIGINT, SIGTERM and SIGKILL sent to the real command.
+
+Each case starts ``python -m tmem ...`` in its own session, waits for a
+moment (right after the start; while it simulates, shown by its progress bar
+on a pseudo-terminal; while it writes, shown by its temporary name appearing;
+while a sweep has saved rows), sends the signal and checks that the
+destination is as it was or complete, never partial.  After SIGKILL, which no
+process can handle, the next run of the same command must complete and
+remove what the killed one left.  Each case is one process start (about 5 s,
+mostly imports; the compiled code comes from Numba's cache, warmed by the
+fixtures).
+"""
+
+import json
+import os
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from dask.distributed import Client, LocalCluster
+from typer.testing import CliRunner
+
+from tmem.cli import app
+from tmem.sweep import loads_sweep, run_sweep
+
+ROOT = Path(__file__).parent.parent
+SIGNALS = {"SIGINT": signal.SIGINT, "SIGTERM": signal.SIGTERM, "SIGKILL": signal.SIGKILL}
+# The repulsion example, long: a few seconds of simulation behind a progress bar, then a few MB to write.
+LONG_RUN = (ROOT / "examples" / "repulsion.toml").read_text().replace("duration = 60.0", "duration = 600.0")
+PAIR_2D = """
+name = "pair2d"
+[space]
+axes = 2
+[interaction]
+function = "improved"
+[simulation]
+dt = 0.001
+duration = 40.0
+record_every = 10
+[[agents]]
+position = [50.0, 0.0]
+velocity = [-1.5, 0.0]
+[[agents]]
+position = [0.0, 0.0]
+velocity = [3.0, 0.0]
+"""
+SWEEP = """
+name = "encounters"
+base = "fig7"
+cases = 20
+seed = 5
+batch = 1
+[set]
+"simulation.dt" = 0.0002
+"simulation.duration" = 40.0
+[grid]
+"interaction.function" = ["switching", "improved"]
+[random]
+"agents.0.position" = { uniform = [45, 70] }
+"agents.0.velocity" = { uniform = [-4, -1] }
+"agents.1.velocity" = { uniform = [1, 4] }
+"""
+N_SWEEP_CASES = 40
+
+
+def partials(folder: Path, name: str) -> list[str]:
+    """Hidden entries of ``folder`` named after ``name``: temporary outputs (this tmem's or an earlier one's)."""
+    return sorted(n for n in os.listdir(folder) if n.startswith(f".{name}."))
+
+
+class Command:
+    """``python -m tmem ARGS`` in a session of its own, its output on a pseudo-terminal (progress bars show)."""
+
+    def __init__(self, *args, cwd: Path):
+        env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "TERM": "xterm", "COLUMNS": "100"}
+        self.master, slave = os.openpty()
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "tmem", *map(str, args)],
+            stdin=subprocess.DEVNULL, stdout=slave, stderr=slave, cwd=cwd, env=env, start_new_session=True,
+        )  # fmt: skip
+        os.close(slave)
+        self.started = time.monotonic()
+        self.output = b""
+
+    def _read(self) -> None:
+        while select.select([self.master], [], [], 0)[0]:
+            try:
+                chunk = os.read(self.master, 65536)
+            except OSError:  # the terminal closed with the process
+                return
+            if not chunk:
+                return
+            self.output += chunk
+
+    def wait_for(self, condition, timeout: float = 60) -> bool:
+        """Wait until ``condition()`` holds (True) or the process ends first (False)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            self._read()
+            if condition():
+                return True
+            if self.process.poll() is not None:
+                return False
+            time.sleep(0.005)
+        raise AssertionError(f"nothing happened in {timeout} s: {self.output[-500:]!r}")
+
+    def send(self, signum: int) -> None:
+        # Ctrl-C reaches the terminal's whole process group; kill(1) and a killer reach one process.
+        if signum == signal.SIGINT:
+            os.killpg(self.process.pid, signum)
+        else:
+            self.process.send_signal(signum)
+
+    def finish(self, timeout: float = 60) -> tuple[int, str]:
+        try:
+            code = self.process.wait(timeout)
+        finally:
+            self._read()
+            try:
+                os.killpg(self.process.pid, signal.SIGKILL)  # anything it started
+            except ProcessLookupError:
+                pass
+            self.process.wait()
+            os.close(self.master)
+        return code, self.output.decode(errors="replace")
+
+
+def moment(command: Command, when: str, writing) -> bool:
+    """Wait for the moment ``when``; False if the command ended first."""
+    if when == "start":
+        return command.wait_for(lambda: time.monotonic() - command.started > 0.2)
+    if when == "simulating":
+        return command.wait_for(lambda: b"%" in command.output and not writing())
+    return command.wait_for(writing)
+
+
+def listed_files(out: Path) -> list[str]:
+    return json.loads((out / ".tmem-output.json").read_text())["files"]
+
+
+def snapshot(directory: Path) -> dict:
+    return {str(p.relative_to(directory)): p.read_bytes() for p in sorted(directory.rglob("*")) if p.is_file()}
+
+
+def check_exit(code: int, output: str, signum: int, when: str) -> None:
+    if signum == signal.SIGKILL:
+        assert code == -signal.SIGKILL
+    elif when != "start":  # before the command installs its handlers, Python's defaults act
+        assert code == 130, output
+        assert "Traceback" not in output, output
+
+
+# --- tmem run
+
+
+@pytest.fixture(scope="module")
+def long_run(tmp_path_factory):
+    """The long scenario, and an earlier complete output of it (also warms Numba's cache)."""
+    folder = tmp_path_factory.mktemp("long")
+    scenario = folder / "long.toml"
+    scenario.write_text(LONG_RUN)
+    previous = folder / "previous"
+    result = CliRunner().invoke(app, ["run", str(scenario), "--out", str(previous)])
+    assert result.exit_code == 0, result.output
+    return scenario, previous
+
+
+@pytest.mark.parametrize("when", ["start", "simulating", "writing"])
+@pytest.mark.parametrize("name", SIGNALS)
+def test_interrupted_run_leaves_the_earlier_output_or_a_whole_new_one(long_run, tmp_path, name, when):
+    scenario, previous = long_run
+    signum = SIGNALS[name]
+    out = tmp_path / "out"
+    shutil.copytree(previous, out)
+    before = snapshot(out)
+    command = Command("run", scenario, "--out", out, cwd=tmp_path)
+    reached = moment(command, when, lambda: bool(partials(tmp_path, "out")))
+    if reached:
+        command.send(signum)
+    code, output = command.finish()
+    assert reached, f"the run ended before the moment {when!r}: {output}"
+    check_exit(code, output, signum, when)
+    after = snapshot(out)
+    assert after == before or sorted(p for p in after if p != ".tmem-output.json") == listed_files(out)
+    if signum != signal.SIGKILL:
+        assert partials(tmp_path, "out") == [], output
+        return
+    # The next run completes and removes what the killed one left.
+    result = CliRunner().invoke(app, ["run", str(scenario), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert partials(tmp_path, "out") == []
+    assert sorted(p.name for p in out.iterdir() if p.name != ".tmem-output.json") == listed_files(out)
+
+
+# --- tmem animate
+
+
+@pytest.fixture(scope="module")
+def run_2d(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("pair2d")
+    scenario = folder / "pair2d.toml"
+    scenario.write_text(PAIR_2D)
+    result = CliRunner().invoke(app, ["run", str(scenario), "--out", str(folder / "run")])
+    assert result.exit_code == 0, result.output
+    return folder / "run"
+
+
+@pytest.mark.parametrize("when", ["start", "writing"])
+@pytest.mark.parametrize("name", SIGNALS)
+def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when):
+    signum = SIGNALS[name]
+    run = tmp_path / "run"
+    shutil.copytree(run_2d, run)
+    gif = run / "animation.gif"
+    command = Command("animate", run, "--max-frames", "40", cwd=tmp_path)
+    reached = moment(command, when, lambda: bool(partials(run, "animation.gif")) or gif.exists())
+    if reached:
+        command.send(signum)
+    code, output = command.finish()
+    assert reached, f"animate ended before the moment {when!r}: {output}"
+    check_exit(code, output, signum, when)
+    # The signal may come as the finished file is being renamed into place: then it is whole.
+    assert not gif.exists() or gif.read_bytes().endswith(b";"), "a partial GIF"  # ";": a GIF's trailer
+    if signum != signal.SIGKILL:
+        assert partials(run, "animation.gif") == []
+        return
+    result = CliRunner().invoke(app, ["animate", str(run), "--max-frames", "3"])
+    assert result.exit_code == 0, result.output
+    assert gif.exists() and partials(run, "animation.gif") == []
+
+
+# --- tmem sweep
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A cluster the sweeps connect to by address, warm (its workers' imports done once)."""
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        with Client(cluster) as client:
+            client.run(lambda: __import__("tmem.sweep.tasks"))
+        yield cluster.scheduler_address
+
+
+@pytest.fixture
+def sweep_file(tmp_path):
+    path = tmp_path / "encounters.toml"
+    path.write_text(SWEEP)
+    return path
+
+
+def saved_rows(out: Path) -> bool:
+    return (out / "parts").is_dir() and any(p.name.startswith("part-") for p in (out / "parts").iterdir())
+
+
+def sweep_leftovers(out: Path) -> list[str]:
+    folders = [out, out / "parts"] if (out / "parts").is_dir() else [out]
+    return sorted(n for folder in folders for n in os.listdir(folder) if ".tmem-partial-" in n or n.endswith(".tmp"))
+
+
+@pytest.mark.parametrize("when", ["start", "saving rows"])
+@pytest.mark.parametrize("name", SIGNALS)
+def test_interrupted_sweep_resumes_and_finishes(cluster, sweep_file, tmp_path, name, when):
+    signum = SIGNALS[name]
+    out = tmp_path / "out"
+    command = Command("sweep", sweep_file, "--out", out, "--scheduler", cluster, cwd=tmp_path)
+    reached = moment(command, when, lambda: saved_rows(out))
+    if reached:
+        command.send(signum)
+    code, output = command.finish()
+    assert reached, f"the sweep ended before the moment {when!r}: {output}"
+    check_exit(code, output, signum, when)
+    if signum != signal.SIGKILL and when != "start":
+        assert "run the same command again" in output
+    assert not (out / "results.parquet").exists()
+    if signum != signal.SIGKILL:
+        assert not out.exists() or sweep_leftovers(out) == []
+    sweep = loads_sweep(SWEEP, source=str(sweep_file))
+    outcome = run_sweep(sweep, out, scheduler=cluster)
+    assert list(outcome.table["case"]) == list(range(N_SWEEP_CASES))
+    assert sweep_leftovers(out) == [] and not (out / ".tmem-lock").exists()
+
+
+def test_two_sweeps_into_one_directory_at_once(cluster, sweep_file, tmp_path):
+    """The second is refused in one line naming the first; once the first is killed, it runs."""
+    out = tmp_path / "out"
+    first = Command("sweep", sweep_file, "--out", out, "--scheduler", cluster, cwd=tmp_path)
+    try:
+        assert first.wait_for(lambda: saved_rows(out)), first.output
+        result = CliRunner().invoke(app, ["sweep", str(sweep_file), "--out", str(out), "--scheduler", cluster])
+        assert result.exit_code == 2, result.output
+        assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+        assert f"another `tmem sweep` (process {first.process.pid}) is writing to it" in result.stderr
+        first.send(signal.SIGKILL)
+    finally:
+        first.finish()
+    result = CliRunner().invoke(app, ["sweep", str(sweep_file), "--out", str(out), "--scheduler", cluster])
+    assert result.exit_code == 0, result.output
+    assert list(pd.read_parquet(out / "results.parquet")["case"]) == list(range(N_SWEEP_CASES))
