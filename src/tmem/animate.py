@@ -230,6 +230,31 @@ def _figure(run: _Run, shown: np.ndarray, dpi: int) -> tuple[Figure, dict]:
     return fig, moving
 
 
+def _shown_and_removed(run) -> tuple[np.ndarray, np.ndarray]:
+    """Positions of the flying agents (NaN otherwise), and of removed agents (inactive after having
+    been active), which stay as crosses where last seen flying (NaN otherwise); each (frame, agent, 2)."""
+    frame = np.arange(len(run.time))[:, None]
+    last = np.maximum.accumulate(np.where(run.active, frame, -1), axis=0)
+    seen_last = run.pos[np.maximum(last, 0), np.arange(run.pos.shape[1])]
+    cross = np.where((~run.active & (last >= 0))[..., None], seen_last, np.nan)
+    shown = np.where(run.active[..., None], run.pos, np.nan)
+    return shown, cross
+
+
+def _update(moving: dict, run, f: int, shown: np.ndarray, cross: np.ndarray, draw_dashed: bool) -> None:
+    """Move the artists to frame ``f``: coupled edges coloured by strain, uncoupled ones dashed, agents, clock."""
+    ends = np.stack([run.pos[f, run.col_i], run.pos[f, run.col_j]], axis=1)  # (edge, 2, 2)
+    flying = run.active[f, run.col_i] & run.active[f, run.col_j]
+    on = flying & (run.flag[f] == 1)
+    moving["coupled"].set_segments(ends[on])
+    moving["coupled"].set_array(np.linalg.norm(ends[on, 1] - ends[on, 0], axis=-1) / run.d_t[on] - 1)
+    moving["dashed"].set_data(*_polyline(ends[flying & (run.flag[f] == 0)] if draw_dashed else ends[:0]).T)
+    moving["circles"].set_offsets(shown[f])
+    moving["dots"].set_offsets(shown[f])
+    moving["crosses"].set_offsets(cross[f])
+    moving["clock"].set_text(f"t = {run.time[f]:.1f} s")
+
+
 def animate(
     run_dir: str | Path,
     out: str | Path | None = None,
@@ -278,13 +303,7 @@ def animate(
     writer = _writer(out, fps)
     check_file(out, label=label)
 
-    # Removed agents (inactive after having been active) stay as crosses where last seen active.
-    frame = np.arange(len(run.time))[:, None]
-    last = np.maximum.accumulate(np.where(run.active, frame, -1), axis=0)
-    seen_last = run.pos[np.maximum(last, 0), np.arange(run.pos.shape[1])]
-    cross = np.where((~run.active & (last >= 0))[..., None], seen_last, np.nan)
-    shown = np.where(run.active[..., None], run.pos, np.nan)
-
+    shown, cross = _shown_and_removed(run)
     fig, moving = _figure(run, shown, dpi)
     ax = fig.axes[0]
     background = fig.canvas.copy_from_bbox(fig.bbox)
@@ -293,16 +312,7 @@ def animate(
         writer.setup(fig, str(tmp), dpi)
         try:
             for f in range(len(run.time)):
-                ends = np.stack([run.pos[f, run.col_i], run.pos[f, run.col_j]], axis=1)  # (edge, 2, 2)
-                flying = run.active[f, run.col_i] & run.active[f, run.col_j]
-                on = flying & (run.flag[f] == 1)
-                moving["coupled"].set_segments(ends[on])
-                moving["coupled"].set_array(np.linalg.norm(ends[on, 1] - ends[on, 0], axis=-1) / run.d_t[on] - 1)
-                moving["dashed"].set_data(*_polyline(ends[flying & (run.flag[f] == 0)] if draw_dashed else ends[:0]).T)
-                moving["circles"].set_offsets(shown[f])
-                moving["dots"].set_offsets(shown[f])
-                moving["crosses"].set_offsets(cross[f])
-                moving["clock"].set_text(f"t = {run.time[f]:.1f} s")
+                _update(moving, run, f, shown, cross, draw_dashed)
                 fig.canvas.restore_region(background)
                 for artist in moving.values():
                     ax.draw_artist(artist)
