@@ -28,6 +28,14 @@ def lock(directory: Path, command: str) -> Iterator[None]:
     The lock is the operating system's (``flock``), so it ends with its
     process, however that ends; the file holds the holder's process id for
     the message and is removed when the block ends.
+
+    Parameters
+    ----------
+    directory : Path
+        The existing directory to lock.
+    command : str
+        The command holding it (``"sweep"``), written in the lock and named
+        in the message of a second one.
     """
     import fcntl
 

@@ -103,7 +103,13 @@ def _files_below(directory: Path, prefix: str = "") -> Iterator[str]:
 
 
 def describe(directory: Path) -> str:
-    """What ``directory`` holds, for a one-line message: ``a `tmem paper` output (fig5/, …)``."""
+    """What ``directory`` holds, for a one-line message: ``a `tmem paper` output (fig5/, …)``.
+
+    Parameters
+    ----------
+    directory : Path
+        An existing directory.
+    """
     entries = _top_entries(directory)
     manifest = _read_manifest(directory)
     if manifest is None:
@@ -116,12 +122,26 @@ def _refuse(out: Path, why: str) -> OutputError:
 
 
 def check_directory(out: str | Path, command: str, adopt: Callable[[Path], bool] | None = None) -> Path:
-    """Refuse an ``out`` that ``command`` may not write to (the rule in the module docstring); return it.
+    """Refuse an ``out`` that ``command`` may not write to (the rule in :mod:`tmem.outputs`); return it.
 
     Reads only; writes nothing.  For ``sweep``, a directory holding a sweep's
     output passes: whether it is the same sweep is for the sweep's store to say.
-    ``adopt(out)``, if given, may accept an existing directory without a
-    manifest that the command recognises as its own (a sweep's, cut short).
+
+    Parameters
+    ----------
+    out : str or Path
+        The output directory (``--out``).
+    command : str
+        The command that would write it: ``"run"``, ``"paper"`` or ``"sweep"``.
+    adopt : callable, optional
+        ``adopt(out) -> bool``: may accept an existing directory without a
+        manifest that the command recognises as its own (a sweep's, cut
+        short).  None: no such directory is accepted.
+
+    Raises
+    ------
+    OutputError
+        If ``command`` may not write to ``out``, in one line saying why.
     """
     out = Path(out)
     try:

@@ -28,6 +28,13 @@ def partial_name(name: str, suffix: str = "") -> str:
 
     ``suffix`` (such as ``.gif``) is kept at the end so that writers which
     choose the format by the suffix still do.
+
+    Parameters
+    ----------
+    name : str
+        The destination's name (its first 180 bytes are kept).
+    suffix : str
+        Appended to the temporary name as it is, such as ``".gif"``; empty for none.
     """
     kept = os.fsdecode(os.fsencode(name)[:_NAME_KEPT])
     return f".{kept}.tmem-partial-{os.getpid()}-{secrets.token_hex(4)}{suffix}"
@@ -57,13 +64,26 @@ def _alive(pid: int) -> bool:
 
 
 def is_leftover(path: Path) -> bool:
-    """Whether ``path`` is a temporary file or directory of a tmem process that is gone."""
+    """Whether ``path`` is a temporary file or directory of a tmem process that is gone.
+
+    Parameters
+    ----------
+    path : Path
+        The entry to judge; only its name is read, and whether the process
+        id in it still runs on this machine.
+    """
     pid = _partial_owner(path.name)
     return pid is not None and not _alive(pid)
 
 
 def remove_leftovers(folder: Path) -> list[Path]:
-    """Remove from ``folder`` (not below it) what killed tmem processes left; return what was removed."""
+    """Remove from ``folder`` (not below it) what killed tmem processes left; return what was removed.
+
+    Parameters
+    ----------
+    folder : Path
+        The folder to clean; one that cannot be listed is left as it is.
+    """
     removed = []
     try:
         entries = list(os.scandir(folder))

@@ -52,6 +52,13 @@ def replace_directory(out: str | Path, command: str) -> Iterator[Path]:
     added and the temporary directory takes ``out``'s place; on any error or
     interruption it is removed, with the parent directories made for it.
     File system errors become :class:`OutputError`.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output directory (``--out``).
+    command : str
+        The command writing it, as its manifest names it: ``"run"`` or ``"paper"``.
     """
     out = check_directory(out, command)
     missing = _missing_parents(out)
@@ -90,6 +97,14 @@ def create_directory(out: Path, command: str) -> Iterator[Path]:
     puts the first files into the temporary directory; together with the
     manifest (which lists no files) they appear at ``out`` at once.  Raises
     :class:`FileExistsError` if ``out`` was filled meanwhile.
+
+    Parameters
+    ----------
+    out : Path
+        The output directory, absent or empty (checked by the caller,
+        :func:`~tmem.outputs.manifest.check_directory`).
+    command : str
+        The command writing it, as its manifest names it (``"sweep"``).
     """
     missing = _missing_parents(out)
     try:
@@ -118,7 +133,15 @@ def create_directory(out: Path, command: str) -> Iterator[Path]:
 
 
 def mark_directory(directory: Path, command: str) -> None:
-    """Write the manifest of a directory written in place (a sweep's, recovered)."""
+    """Write the manifest of a directory written in place (a sweep's, recovered).
+
+    Parameters
+    ----------
+    directory : Path
+        The existing output directory; its manifest lists no files.
+    command : str
+        The command that wrote it, as the manifest names it (``"sweep"``).
+    """
     write_atomically(directory / MANIFEST, lambda tmp: _write_manifest_file(tmp, command))
 
 # --------------------------------------------------------------------------------------------
@@ -126,7 +149,16 @@ def mark_directory(directory: Path, command: str) -> None:
 
 
 def write_atomically(path: Path, write: Callable[[Path], object]) -> None:
-    """Call ``write(tmp)`` for a temporary path beside ``path`` (same suffix), then rename it to ``path``."""
+    """Call ``write(tmp)`` for a temporary path beside ``path`` (same suffix), then rename it to ``path``.
+
+    Parameters
+    ----------
+    path : Path
+        The file to write; its folder must exist.
+    write : callable
+        ``write(tmp)`` writes the whole file at ``tmp``; what it returns is
+        ignored.  If it raises, ``path`` is left as it was.
+    """
     tmp = path.with_name(partial_name(path.name, path.suffix))
     try:
         write(tmp)
@@ -148,7 +180,23 @@ def _has_mark(path: Path, mark: bytes) -> bool:
 
 
 def check_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out ") -> Path:
-    """Refuse a file ``out`` that may not be written: a directory, a link, or a file without ``mark``."""
+    """Refuse a file ``out`` that may not be written: a directory, a link, or a file without ``mark``; return it.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output file.
+    mark : str
+        The text an existing file must hold (in its first 64 KiB or last
+        1 MiB) to be replaced: tmem wrote it.
+    label : str
+        Put before ``out`` in the message, such as ``"--out "``.
+
+    Raises
+    ------
+    OutputError
+        If ``out`` may not be written, in one line saying why.
+    """
     out = Path(out)
     where = f"{label}{out}"
     try:
@@ -176,7 +224,21 @@ def _check_file(out: Path, mark: str, where: str) -> Path:
 
 @contextmanager
 def replace_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out ") -> Iterator[Path]:
-    """Yield a temporary path (with ``out``'s suffix) that becomes ``out`` only if the block completes."""
+    """Yield a temporary path (with ``out``'s suffix) that becomes ``out`` only if the block completes.
+
+    ``out`` is checked first (:func:`check_file`) and again just before it is
+    replaced; on any error or interruption the temporary file is removed,
+    with the parent directories made for it.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output file.
+    mark : str
+        The text an existing ``out`` must hold to be replaced (:func:`check_file`).
+    label : str
+        Put before ``out`` in messages, such as ``"--out "``.
+    """
     out = check_file(out, mark, label)
     missing = _missing_parents(out)
     tmp = out.with_name(partial_name(out.name, out.suffix))
