@@ -34,6 +34,11 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     of the recorded agents over time.  Units are in each variable's
     attributes; the scenario (as TOML), the gains and the events are in the
     dataset's attributes.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
     """
     n_axes = trajectory.scenario.space.axes
     coords = {
@@ -78,12 +83,26 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
 
 
 def check_output_directory(out: str | Path) -> Path:
-    """Refuse an ``out`` that ``tmem run`` may not replace (:func:`tmem.outputs.check_directory`); return it."""
+    """Refuse an ``out`` that ``tmem run`` may not replace (:func:`tmem.outputs.manifest.check_directory`); return it.
+
+    Parameters
+    ----------
+    out : str or Path
+        The run directory (``--out``).
+    """
     return check_directory(out, "run")
 
 
 def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
-    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``."""
+    """Write ``summary.json``, ``trajectory.nc`` and the figures into ``directory``; return the summary.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    directory : Path
+        An existing directory (the temporary one of :func:`write_run`).
+    """
     summary = metrics.summarize(trajectory)
     (directory / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
     to_dataset(trajectory).to_netcdf(directory / "trajectory.nc", engine="h5netcdf")
@@ -92,6 +111,15 @@ def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
 
 
 def write_run(trajectory: Trajectory, out: str | Path) -> dict:
-    """Write a complete run directory at ``out`` (atomically) and return its summary."""
+    """Write a complete run directory at ``out`` (atomically) and return its summary.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    out : str or Path
+        The run directory (``--out``); an existing one is replaced only as
+        :mod:`tmem.outputs` allows.
+    """
     with replace_directory(out, "run") as tmp:
         return write_run_files(trajectory, tmp)

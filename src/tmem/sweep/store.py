@@ -57,7 +57,16 @@ _OLD_TEMPORARY = re.compile(r"\.(results\.parquet|part-[0-9]+-[0-9a-f]{8}\.parqu
 
 
 class ResultStore:
-    """The rows of one sweep in its output directory; see the module docstring."""
+    """The rows of one sweep in its output directory; see the module docstring.
+
+    Parameters
+    ----------
+    out : Path
+        The sweep's output directory (``--out``); :meth:`check` makes a store
+        after checking it.
+    sweep : Sweep
+        The sweep whose rows it holds (:func:`tmem.sweep.load_sweep`).
+    """
 
     def __init__(self, out: Path, sweep: Sweep):
         self.out = out
@@ -69,6 +78,18 @@ class ResultStore:
         """The store of ``sweep`` at ``out``: new, empty, or holding this sweep's results so far.
 
         Reads only: nothing is written until :meth:`opened`.
+
+        Parameters
+        ----------
+        out : str or Path
+            The sweep's output directory (``--out``).
+        sweep : Sweep
+            The sweep to run there.
+
+        Raises
+        ------
+        OutputError
+            If ``out`` holds anything but this sweep's output, in one line.
         """
         out = Path(out)
         check_directory(out, "sweep", adopt=lambda directory: _only_a_first_sweep_toml(directory, sweep))
@@ -130,7 +151,14 @@ class ResultStore:
         return done
 
     def add(self, rows: list[dict]) -> None:
-        """Write ``rows`` as a new part (whole or not at all)."""
+        """Write ``rows`` as a new part (whole or not at all).
+
+        Parameters
+        ----------
+        rows : list of dict
+            One row per finished case: ``case``, the swept parameters, the
+            metrics, ``error`` and ``seconds``.  An empty list writes nothing.
+        """
         if not rows:
             return
         frame = self._frame(rows)
