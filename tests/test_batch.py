@@ -35,3 +35,31 @@ def test_batch_equals_the_engine(function, switch_at):
 def test_batch_refuses_what_it_cannot_run():
     with pytest.raises(ValueError, match="two agents"):
         run_batch(tmem.load("examples/swarm/triangle.toml"), np.zeros((1, 2)), np.zeros((1, 2)))
+
+
+BAD_STARTS = {
+    "nan position": ([[np.nan, 0.0]], [[-1.5, 3.0]], "positions[0, 0]"),
+    "inf velocity": ([[50.0, 0.0]], [[-1.5, np.inf]], "velocities[0, 1]"),
+    "huge position": ([[50.0, 1e300]], [[-1.5, 3.0]], "positions[0, 1]"),
+    "same place": ([[50.0, 0.0], [7.0, 7.0]], [[-1.5, 3.0], [1.0, -1.0]], "positions[1]"),
+    "one agent": ([[50.0]], [[-1.5]], "positions: must have shape (cases, 2)"),
+    "flat": ([50.0, 0.0], [-1.5, 3.0], "positions: must have shape (cases, 2)"),
+    "no cases": (np.empty((0, 2)), np.empty((0, 2)), "positions: must have shape"),
+    "cases differ": ([[50.0, 0.0]], [[-1.5, 3.0], [1.0, 1.0]], "velocities: has 2 cases"),
+    "text": ([["a", "b"]], [[-1.5, 3.0]], "positions: must be numbers"),
+}
+
+
+@pytest.mark.parametrize("name", BAD_STARTS, ids=list(BAD_STARTS))
+def test_bad_starts_are_refused_in_one_line(name):
+    """As ``tmem run`` refuses them (regression: these ran, returning NaN or +167 %)."""
+    positions, velocities, where = BAD_STARTS[name]
+    with pytest.raises(ValueError) as info:
+        run_batch(tmem.preset("fig9"), positions, velocities)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith("run_batch: ") and where in message, message
+
+
+def test_a_scenario_that_is_not_one_is_refused():
+    with pytest.raises(ValueError, match="run_batch: scenario: must be a tmem Scenario"):
+        run_batch({"name": "fig9"}, [[50.0, 0.0]], [[-1.5, 3.0]])

@@ -29,7 +29,7 @@ from .engine.driver import law_of
 from .interaction.kernels import pair_control
 from .model import vehicle_model
 from .model.linear import hold_step
-from .scenario import Scenario
+from .scenario import LIMIT, Scenario
 
 
 @dataclass(frozen=True)
@@ -166,6 +166,25 @@ def unsupported(scenario: Scenario) -> str | None:
     return None
 
 
+def _starts(name: str, values, cases: int | None) -> np.ndarray:
+    """``values`` as a float array of shape (cases, 2), finite and bounded as a scenario's; else ValueError."""
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"run_batch: {name}: must be numbers, shape (cases, 2) ({exc})") from None
+    if array.ndim != 2 or array.shape[1] != 2 or len(array) == 0:
+        raise ValueError(f"run_batch: {name}: must have shape (cases, 2) with at least one case, got {array.shape}")
+    if cases is not None and len(array) != cases:
+        raise ValueError(f"run_batch: {name}: has {len(array)} cases, positions has {cases}")
+    bad = ~np.isfinite(array) | (np.abs(array) > LIMIT)
+    if bad.any():
+        case, agent = np.argwhere(bad)[0]
+        raise ValueError(
+            f"run_batch: {name}[{case}, {agent}]: must be a finite number of magnitude at most {LIMIT:g}, got {array[case, agent]}"
+        )
+    return array
+
+
 def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray) -> BatchResult:
     """Run ``scenario`` once per case, with the two agents' starts taken from the arrays.
 
@@ -176,16 +195,31 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
         shared by all cases.  At most one command, an uncouple of the pair.
     positions, velocities : ndarray, shape (cases, 2)
         Each case's start (tilts and tilt rates zero).
+
+    Raises
+    ------
+    ValueError
+        One line naming the argument, as ``tmem run`` refuses a scenario: a
+        scenario a batch cannot run, starts of the wrong shape, not finite,
+        or two agents at one place.
     """
+    if not isinstance(scenario, Scenario):
+        raise ValueError(f"run_batch: scenario: must be a tmem Scenario, got {type(scenario).__name__}")
     reason = unsupported(scenario)
     if reason:
         raise ValueError(f"run_batch: {reason}")
+    positions = _starts("positions", positions, None)
+    velocities = _starts("velocities", velocities, len(positions))
+    same = np.flatnonzero(positions[:, 0] == positions[:, 1])
+    if len(same):
+        raise ValueError(
+            f"run_batch: positions[{same[0]}]: both agents at {positions[same[0], 0]}: "
+            "two agents at one point have no direction to part in"
+        )
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
     hold = model.step_params(sim.dt)
     law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r))
-    positions = np.asarray(positions, dtype=float)
-    velocities = np.asarray(velocities, dtype=float)
     cases = len(positions)
     start = np.zeros((cases, 2, 4))
     start[:, :, 0] = positions

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import stat
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -19,6 +20,9 @@ from pydantic import ValidationError
 
 from .schema import Scenario
 from .tables import MODEL_KINDS, FieldError, ScenarioError
+
+#: Largest scenario or sweep file read (bytes): a bigger one is a mistake, not a scenario.
+MAX_FILE_BYTES = 16 * 2**20
 
 #: The shipped scenarios, ``src/tmem/presets/NAME.toml``.
 PRESETS = ("fig5", "fig7", "fig9", "repulsion")
@@ -96,11 +100,14 @@ def from_dict(data: dict) -> Scenario:
         return Scenario.model_validate(data)
     except ValidationError as exc:
         raise ScenarioError(describe(exc)) from None
+    except RecursionError:
+        raise ScenarioError("a value is nested too deeply (lists or tables inside one another)") from None
 
 
 def read_text(path: Path, what: str, error: type[ValueError]) -> str:
     """The text of the ``what`` file at ``path``; a missing or unreadable file raises ``error`` in one line.
 
+<<<<<<< HEAD
     Parameters
     ----------
     path : Path
@@ -109,8 +116,19 @@ def read_text(path: Path, what: str, error: type[ValueError]) -> str:
         What the file holds, for the message (``"scenario"``, ``"sweep"``).
     error : type of ValueError
         The exception raised with the one-line message.
+=======
+    Only a regular file of at most :data:`MAX_FILE_BYTES` is read: a FIFO, a device such as
+    ``/dev/zero`` or a huge file is refused before it is opened, so that reading always ends.
+>>>>>>> validation
     """
     try:
+        info = path.stat()
+        if stat.S_ISDIR(info.st_mode):
+            raise IsADirectoryError
+        if not stat.S_ISREG(info.st_mode):
+            raise error(f"{path}: is not a regular file (a pipe or a device?), not a {what} file")
+        if info.st_size > MAX_FILE_BYTES:
+            raise error(f"{path}: is {info.st_size} bytes, more than a {what} file may be ({MAX_FILE_BYTES // 2**20} MiB)")
         return path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise error(f"{path}: no such file") from None
@@ -132,7 +150,18 @@ def load(path: str | Path) -> Scenario:
     return loads(read_text(path, "scenario", ScenarioError), source=str(path))
 
 
+def parse_toml(text: str, source: str, error: type[ValueError]) -> dict:
+    """``text`` parsed as TOML; a syntax error, or nesting too deep to parse, raises ``error`` in one line."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{source}: TOML syntax error: {exc}") from None
+    except RecursionError:
+        raise error(f"{source}: TOML nested too deeply (arrays or inline tables inside one another)") from None
+
+
 def loads(text: str, source: str = "<scenario>") -> Scenario:
+<<<<<<< HEAD
     """Parse and validate scenario TOML text; raise :class:`ScenarioError`.
 
     Parameters
@@ -146,6 +175,10 @@ def loads(text: str, source: str = "<scenario>") -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{source}: TOML syntax error: {exc}") from None
+=======
+    """Parse and validate scenario TOML text; raise :class:`ScenarioError`."""
+    data = parse_toml(text, source, ScenarioError)
+>>>>>>> validation
     try:
         return from_dict(data)
     except ScenarioError as exc:

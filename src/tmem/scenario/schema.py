@@ -12,8 +12,12 @@ line of a :class:`ScenarioError`.  Defaults are documented in
 
 from __future__ import annotations
 
+import math
+import os
+import unicodedata
+
 import numpy as np
-from pydantic import model_validator
+from pydantic import field_validator, model_validator
 
 from ..formation import generate
 from ..interaction.registry import uses_coupling
@@ -41,6 +45,31 @@ MAX_AGENTS_ALL_PAIRS = 2000
 #: Without a formation, swarms up to this size have every pair tracked (recorded distances,
 #: per-pair figures) even when the function has no coupling flag.
 TRACK_ALL_PAIRS = 32
+#: Most characters in a scenario's ``name`` (it titles figures and tables).
+MAX_NAME_LENGTH = 200
+#: Most of (fastest closed-loop root) x dt.  The control is held over a step, and the error this
+#: makes grows about linearly with it: Fig. 9's RMS change is +0.33 % at 0.0012 (dt = 1e-4 s),
+#: +0.54 % at 0.012, +2.6 % at 0.12, +5.0 % at 0.24 and +12.6 % at 0.6 (dt = 0.05 s).  Beyond
+#: 0.15 the error (over 3 percentage points) is of the size of the difference between (10) and
+#: (11) that the paper reports, so a run could no longer tell them apart (docs/parameters.md).
+MAX_ROOT_DT = 0.15
+#: Smallest position gain K_P: below it the gains (4) lose their precision and soon underflow to 0.
+MIN_K_P = 1e-150
+#: Bytes of working memory a run needs per agent and axis (state, its copy, the control, the
+#: neighbour search's cells) and per agent (Verlet pairs, found lists, sort order), rounded up.
+WORK_BYTES_PER_AGENT_AXIS = 128
+WORK_BYTES_PER_AGENT = 256
+#: Bytes per tracked pair while running (flag, distances, both directions of the edge), rounded up.
+WORK_BYTES_PER_PAIR = 96
+
+
+def memory_limit() -> int:
+    """Most bytes a run may need: 16 GiB, or half this machine's memory if that is less."""
+    try:
+        physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        physical = 0
+    return min(16 * 2**30, physical // 2) if physical > 0 else 16 * 2**30
 
 
 class Scenario(StrictModel):
@@ -65,6 +94,16 @@ class Scenario(StrictModel):
     swarm: SwarmParams | None = None
     agents: list[Agent] = []
     commands: list[Command] = []
+
+    @field_validator("name")
+    @classmethod
+    def _printable_name(cls, v: str) -> str:
+        if len(v) > MAX_NAME_LENGTH:
+            raise ValueError(f"must be at most {MAX_NAME_LENGTH} characters (it titles the figures), got {len(v)}")
+        for k, ch in enumerate(v):
+            if unicodedata.category(ch) in ("Cc", "Cf", "Cs", "Co", "Cn") and ch != " ":
+                raise ValueError(f"must be printable text: character {k} is {ch!r}")
+        return v
 
     @property
     def n_agents(self) -> int:
@@ -102,6 +141,8 @@ class Scenario(StrictModel):
         n = self.n_agents
         if n < 2:
             raise FieldError("agents", f"needs at least 2 agents, got {n}")
+        self._check_space()
+        self._check_sampling()
         if self.formation is not None:
             self._check_formation(axes, n)
         elif uses_coupling(self.interaction.function) and n > MAX_AGENTS_ALL_PAIRS:
@@ -120,10 +161,71 @@ class Scenario(StrictModel):
             for k, a in enumerate(self.simulation.record_agents):
                 if not 0 <= a < n:
                     raise FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
+        self._check_memory(n)  # before generating anything
         pairs = self.pairs()  # generating a large formation is not free: once per validation
+        if self.simulation.record_agents == [] and not len(pairs):
+            raise FieldError(
+                "simulation.record_agents", "is empty and there are no pairs to record: the run would record nothing"
+            )
         self._check_commands(n, pairs)
         self._check_record_size(n, len(pairs))
         return self
+
+    def _check_space(self) -> None:
+        space, reach = self.space, self.interaction.reach
+        if space.periodic and space.box is not None:
+            for k, side in enumerate(space.box):
+                if side < reach:
+                    raise FieldError(
+                        f"space.box[{k}]",
+                        f"{side:g} m is shorter than R + R_j = {reach:g} m: in a periodic box every agent "
+                        "would meet its own images; make the box at least that wide",
+                    )
+
+    def _check_sampling(self) -> None:
+        """The gains must not underflow, and dt must resolve the closed loop A - B K (roots (5))."""
+        c, model, dt = self.controller, self.model, self.simulation.dt
+        left = c.r_l**2 + c.im_l**2
+        k_p = left * c.im_r**2 / (model.g * model.kp * model.kd)
+        if not k_p >= MIN_K_P:
+            field, value = ("controller.im_r", c.im_r) if c.im_r**2 < left else ("controller.r_l", c.r_l)
+            raise FieldError(
+                field, f"{value:g} makes the position gain K_P = {k_p:.3g} (at least {MIN_K_P:g}): the gains (4) underflow"
+            )
+        # The modal gains place the roots (5) exactly; the fastest has the largest modulus.
+        fastest = max(math.hypot(c.r_l, c.im_l), c.im_r)
+        if fastest * dt > MAX_ROOT_DT:
+            raise FieldError(
+                "simulation.dt",
+                f"{dt:g} s is too coarse for the closed loop: its fastest root ({fastest:.4g} rad/s) x dt = "
+                f"{fastest * dt:.3g}, at most {MAX_ROOT_DT:g} (dt <= {MAX_ROOT_DT / fastest:.3g} s; see docs/parameters.md)",
+            )
+
+    def _pair_count(self, n: int) -> int:
+        """How many pairs :meth:`pairs` gives, without generating them (an upper bound for a hex)."""
+        f = self.formation
+        if f is None:
+            coupled = uses_coupling(self.interaction.function) or n <= TRACK_ALL_PAIRS
+            return n * (n - 1) // 2 if coupled else 0
+        return {"chain": n - 1, "ring": n, "triangle": 3, "hex": 3 * n}.get(f.kind, len(f.edges or ()))
+
+    def _check_memory(self, n: int) -> None:
+        sim, axes = self.simulation, self.space.axes
+        pairs = self._pair_count(n)
+        records = sim.n_steps // sim.record_every + 2
+        recorded = n if sim.record_agents is None else len(sim.record_agents)
+        kept = records * (recorded * (5 * axes * 8 + 1) + pairs * 32)
+        work = n * (WORK_BYTES_PER_AGENT + axes * WORK_BYTES_PER_AGENT_AXIS) + pairs * WORK_BYTES_PER_PAIR
+        need, limit = kept + work, memory_limit()
+        if need > limit:
+            field = "swarm.n" if self.swarm is not None else ("formation.n" if self.formation and self.formation.n else "agents")
+            if work <= limit:  # the agents fit: their records are what does not
+                field = "simulation.record_every"
+            raise FieldError(
+                field,
+                f"{n} agents would need about {need / 2**30:.3g} GiB to run (at most {limit / 2**30:.3g} GiB); "
+                "fewer agents, or record less (record_every, record_agents)",
+            )
 
     def _check_record_size(self, n: int, pairs: int) -> None:
         sim = self.simulation
@@ -199,6 +301,12 @@ class Scenario(StrictModel):
         active = [a.active for a in self.agents] if self.agents else [True] * n
         for k, command in sorted(enumerate(self.commands), key=lambda kc: kc[1].time):
             where = f"commands[{k}]"
+            if command.action == "couple" and not uses_coupling(self.interaction.function):
+                raise FieldError(
+                    f"{where}.action",
+                    f"'couple' does nothing: interaction.function {self.interaction.function!r} has no coupling flag "
+                    "(use 'switching' (10) or 'improved' (11))",
+                )
             if command.time > self.simulation.duration:
                 raise FieldError(
                     f"{where}.time", f"must not be later than duration = {self.simulation.duration:g} s, got {command.time:g}"

@@ -149,6 +149,15 @@ class SimulationParams(StrictModel):
         steps = self.duration / self.dt
         if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
             raise FieldError("duration", f"must be a whole number of steps dt = {self.dt:g} s, got {self.duration:g}")
+        first: dict[int, int] = {}
+        for k, agent in enumerate(self.record_agents or []):
+            if agent in first:
+                raise FieldError(f"record_agents[{k}]", f"lists agent {agent} again (first at [{first[agent]}])")
+            first[agent] = k
+        if self.record_every > max(self.n_steps, 1):
+            raise FieldError(
+                "record_every", f"must not exceed the run's {self.n_steps} steps (duration / dt), got {self.record_every}"
+            )
         return self
 
 
@@ -186,7 +195,7 @@ class FormationParams(StrictModel):
     center: list[Number] | None = None
     velocity: list[Number] | None = None
     jitter: NonNegative = 0.0
-    seed: int = 0
+    seed: Annotated[int, Field(ge=0)] = 0
     coupled: bool = True
 
     @model_validator(mode="after")
@@ -213,7 +222,7 @@ class SwarmParams(StrictModel):
     """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``."""
 
     n: Annotated[int, Field(ge=2)]
-    seed: int = 0
+    seed: Annotated[int, Field(ge=0)] = 0
     region: list[Positive] | None = None
     speed_rms: NonNegative = 0.0
 
@@ -252,6 +261,13 @@ class Command(StrictModel):
                 raise FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
             if self.pair is not None and self.pairs is not None:
                 raise FieldError("pairs", "give pair or pairs, not both")
+            if self.pairs is not None and not self.pairs:
+                raise FieldError("pairs", "is empty: leave it out to act on every formation pair, or list at least one")
+            seen: set[tuple[int, int]] = set()
+            for k, (i, j) in enumerate(self.pairs or []):
+                if (min(i, j), max(i, j)) in seen:
+                    raise FieldError(f"pairs[{k}]", f"names the pair {sorted((i, j))} a second time")
+                seen.add((min(i, j), max(i, j)))
         else:
             if self.agent is None:
                 raise FieldError("agent", f"is required for {self.action}")

@@ -42,7 +42,6 @@ import itertools
 import json
 import math
 import re
-import tomllib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -64,6 +63,7 @@ from ..scenario import (
     read_text,
     with_changes,
 )
+from ..scenario.files import parse_toml
 
 #: Metrics of ``summary.json`` (:func:`tmem.metrics.summarize`) a sweep can keep, with the batch's too.
 SCALAR_METRICS = (
@@ -91,6 +91,17 @@ class SweepError(ValueError):
     """A sweep that cannot be run; the message is one line naming the key."""
 
 
+def _kind(value: Any) -> str:
+    """The kind of a value as a results column sees it (an integer and a float are both numbers)."""
+    if isinstance(value, bool):
+        return "booleans"
+    if isinstance(value, int | float):
+        return "numbers"
+    if isinstance(value, str):
+        return "strings"
+    return "lists or tables"
+
+
 class Distribution(StrictModel):
     """How one parameter is drawn: exactly one of the four kinds."""
 
@@ -112,6 +123,10 @@ class Distribution(StrictModel):
             raise FieldError("loguniform", f"low must be > 0, got {self.loguniform[0]}")
         if self.normal is not None and self.normal[1] < 0:
             raise FieldError("normal", f"the standard deviation must be >= 0, got {self.normal[1]}")
+        if self.choice is not None:
+            kinds = {_kind(v) for v in self.choice}
+            if len(kinds) > 1:  # one results column holds them all: it needs one type
+                raise FieldError("choice", f"mixes {' and '.join(sorted(kinds))}; give values of one kind, got {self.choice}")
         return self
 
     def draw(self, rng: np.random.Generator, n: int) -> list:
@@ -153,6 +168,9 @@ class SweepFile(StrictModel):
         for path, values in self.grid.items():
             if not values:
                 raise FieldError(f"grid.{path}", "is empty; give at least one value")
+            kinds = {_kind(v) for v in values}
+            if len(kinds) > 1:
+                raise FieldError(f"grid.{path}", f"mixes {' and '.join(sorted(kinds))}; give values of one kind")
         if self.random and self.cases is None:
             raise FieldError("cases", "is required with a [random] table: how many draws")
         if self.cases is not None and not self.random:
@@ -292,10 +310,7 @@ def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = Non
     directory : Path or None
         Where a relative ``base`` file is found; default: the current directory.
     """
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"{source}: TOML syntax error: {exc}") from None
+    data = parse_toml(text, source, SweepError)
     for table in ("set", "grid", "random"):
         if isinstance(data.get(table), dict):
             data[table] = _dotted(data[table])
