@@ -107,7 +107,9 @@ def from_dict(data: dict) -> Scenario:
 def read_text(path: Path, what: str, error: type[ValueError]) -> str:
     """The text of the ``what`` file at ``path``; a missing or unreadable file raises ``error`` in one line.
 
-<<<<<<< HEAD
+    Only a regular file of at most :data:`MAX_FILE_BYTES` is read: a FIFO, a device such as
+    ``/dev/zero`` or a huge file is refused before it is opened, so that reading always ends.
+
     Parameters
     ----------
     path : Path
@@ -116,10 +118,6 @@ def read_text(path: Path, what: str, error: type[ValueError]) -> str:
         What the file holds, for the message (``"scenario"``, ``"sweep"``).
     error : type of ValueError
         The exception raised with the one-line message.
-=======
-    Only a regular file of at most :data:`MAX_FILE_BYTES` is read: a FIFO, a device such as
-    ``/dev/zero`` or a huge file is refused before it is opened, so that reading always ends.
->>>>>>> validation
     """
     try:
         info = path.stat()
@@ -151,7 +149,17 @@ def load(path: str | Path) -> Scenario:
 
 
 def parse_toml(text: str, source: str, error: type[ValueError]) -> dict:
-    """``text`` parsed as TOML; a syntax error, or nesting too deep to parse, raises ``error`` in one line."""
+    """``text`` parsed as TOML; a syntax error, or nesting too deep to parse, raises ``error`` in one line.
+
+    Parameters
+    ----------
+    text : str
+        The TOML text.
+    source : str
+        Where the text came from, at the start of an error message.
+    error : type of ValueError
+        The exception raised with the one-line message.
+    """
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -161,7 +169,6 @@ def parse_toml(text: str, source: str, error: type[ValueError]) -> dict:
 
 
 def loads(text: str, source: str = "<scenario>") -> Scenario:
-<<<<<<< HEAD
     """Parse and validate scenario TOML text; raise :class:`ScenarioError`.
 
     Parameters
@@ -171,14 +178,7 @@ def loads(text: str, source: str = "<scenario>") -> Scenario:
     source : str
         Where the text came from, at the start of an error message.
     """
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{source}: TOML syntax error: {exc}") from None
-=======
-    """Parse and validate scenario TOML text; raise :class:`ScenarioError`."""
     data = parse_toml(text, source, ScenarioError)
->>>>>>> validation
     try:
         return from_dict(data)
     except ScenarioError as exc:
