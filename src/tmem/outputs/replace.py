@@ -61,14 +61,7 @@ def replace_directory(out: str | Path, command: str) -> Iterator[Path]:
         The command writing it, as its manifest names it: ``"run"`` or ``"paper"``.
     """
     out = check_directory(out, command)
-    missing = _missing_parents(out)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        remove_leftovers(out.parent)
-        tmp = _new_partial_directory(out)
-    except OSError as exc:
-        _remove_made(missing)
-        raise _cannot_write(out, exc) from None
+    tmp, missing = _partial_beside(out)
     try:
         yield tmp
         _write_manifest(tmp, command)
@@ -106,14 +99,7 @@ def create_directory(out: Path, command: str) -> Iterator[Path]:
     command : str
         The command writing it, as its manifest names it (``"sweep"``).
     """
-    missing = _missing_parents(out)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        remove_leftovers(out.parent)
-        tmp = _new_partial_directory(out)
-    except OSError as exc:
-        _remove_made(missing)
-        raise _cannot_write(out, exc) from None
+    tmp, missing = _partial_beside(out)
     try:
         yield tmp
         _write_manifest(tmp, command, listed=False)
@@ -255,3 +241,16 @@ def replace_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out 
         if isinstance(exc, OSError):
             raise OutputError(f"{label}{out}: cannot be written ({exc.strerror or exc})") from None
         raise
+
+
+def _partial_beside(out: Path) -> tuple[Path, list[Path]]:
+    """A new partial directory beside ``out`` (its parents made as needed, dead writers' leftovers
+    removed), and the parents that had to be made, to remove again if the writing fails."""
+    missing = _missing_parents(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        remove_leftovers(out.parent)
+        return _new_partial_directory(out), missing
+    except OSError as exc:
+        _remove_made(missing)
+        raise _cannot_write(out, exc) from None
