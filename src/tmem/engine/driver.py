@@ -28,6 +28,7 @@ from ..neighbors import all_pairs, arrange, spatial_order, verlet_pairs
 from ..scenario import Scenario
 from ..sensing import Sensing, exact
 from .loop import advance_for
+from .stages import CHUNK
 from .records import (
     COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Law, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
@@ -123,6 +124,7 @@ class _NeighbourLister:
         self.adj_ptr, self.adj_idx = _partners(n_agents, edges_in_slots)
         self.block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
         self.block_nearest2 = np.empty(len(self.block_ptr) - 1)
+        self.chunks = np.empty((len(self.block_ptr), 2 * n_axes + 1, CHUNK))
         self.closest = np.full(1, np.inf)  # the smallest squared distance between neighbours so far
         self.p_ref = np.zeros((n_agents, n_axes))
         if use_lists:  # pairs are unsigned, as all_pairs gives them: no negative-index check in the loop
@@ -144,7 +146,8 @@ class _NeighbourLister:
             self.pairs = all_pairs(active)
             listed = len(self.pairs)
         n_inside, n_pairs = arrange(self.pairs, listed, self.adj_ptr, self.adj_idx, BLOCK, self.block_ptr)
-        return Neighbours(self.pairs, n_inside, n_pairs, self.block_ptr, self.p_ref, self.block_nearest2, self.closest)
+        return Neighbours(self.pairs, n_inside, n_pairs, self.block_ptr, self.p_ref, self.block_nearest2, self.closest,
+                          self.chunks)  # fmt: skip
 
 
 def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int) -> Records:
@@ -204,7 +207,8 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     edges = initial.edges
     n_edges = len(edges)
     pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
-                  np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf))  # fmt: skip
+                  np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf),
+                  np.empty(n_axes))  # fmt: skip
     commands = _commands(scenario, edges, slot)
     steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
     recorded = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)

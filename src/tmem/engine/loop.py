@@ -21,7 +21,7 @@ from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any
 from ..space import into_box
 from ..sensing import measure
 from .records import DONE, LISTS_STALE
-from .stages import apply_commands, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record, tilt_scale
+from .stages import apply_commands, commands_due, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record, tilt_scale
 
 
 def vehicle_step(x, u, i, scale, params, n_axes):
@@ -50,7 +50,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     active = agents.active
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
-        rebuild = apply_commands(k, commands, agents, pairs, events, counters)
+        rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters)
         known = measure(x, sensing)
         moved2 = corrected_positions(known, agents, law, run, neighbours)
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):

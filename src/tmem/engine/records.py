@@ -121,6 +121,9 @@ class Pairs(NamedTuple):
         ``|d|`` one step earlier (NaN before the first step).
     min_distance : ndarray, shape (pairs,)
         Smallest ``|P_j - P_i|`` so far.
+    d : ndarray, shape (axes,)
+        Work space: one pair's ``d = P*_j - P*_i``.  The loop allocates nothing at each step;
+        at two agents an allocation per step costs as much as the step itself.
     """
 
     i: np.ndarray
@@ -131,6 +134,7 @@ class Pairs(NamedTuple):
     armed: np.ndarray
     r_before: np.ndarray
     min_distance: np.ndarray
+    d: np.ndarray
 
 
 class Neighbours(NamedTuple):
@@ -149,6 +153,8 @@ class Neighbours(NamedTuple):
         Work space: each block's smallest squared distance this step.
     closest : ndarray, shape (1,)
         Smallest squared distance of two agents within reach so far.
+    chunks : ndarray, shape (blocks + 1, 2 axes + 1, CHUNK)
+        Work space: the chunk of pairs each block sums (the last row: the pairs between blocks).
     """
 
     pairs: np.ndarray
@@ -158,6 +164,7 @@ class Neighbours(NamedTuple):
     p_ref: np.ndarray
     block_nearest2: np.ndarray
     closest: np.ndarray
+    chunks: np.ndarray
 
 
 class Commands(NamedTuple):

@@ -1,9 +1,11 @@
 """The compiled stages of one step, each one idea, in the order the loop runs them.
 
 Every stage is a Numba function inlined into the loop (:mod:`tmem.engine.loop`)
-and works on the records of :mod:`tmem.engine.records` in place:
+except the carrying out of commands, which is rare, and works on the records
+of :mod:`tmem.engine.records` in place.  Nothing is allocated at a step: the
+work space comes in the records.
 
-1. :func:`apply_commands` — operator commands due at the step;
+1. :func:`apply_commands` — operator commands due at the step (:func:`commands_due`);
 2. measurement (:func:`tmem.sensing.measure`) — the states as each agent knows them;
 3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
    lists have drifted;
@@ -60,8 +62,26 @@ def log_event(events, counters, k, kind, i, j, action):
 
 
 @numba.njit(cache=True, inline="always")
+def commands_due(k, commands, counters):
+    """Whether a command is due at step ``k`` (the check the loop makes at every step).
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    commands, counters
+        The loop's records (:mod:`tmem.engine.records`).
+    """
+    c = counters.next_command[0]
+    return c < commands.step.shape[0] and commands.step[c] <= k
+
+
+@numba.njit(cache=True)
 def apply_commands(k, commands, agents, pairs, events, counters):
     """Carry out the commands due at step ``k``; return whether the neighbour lists must be rebuilt.
+
+    Commands are rare: the loop calls this only when :func:`commands_due`, and it is not inlined.
+    Inlined, its code slowed every step of a two-agent run by a quarter.
 
     ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.coupling`); ``remove`` stops an agent
     where it is (a lost vehicle), ``add`` puts it back at its start.
@@ -74,7 +94,7 @@ def apply_commands(k, commands, agents, pairs, events, counters):
         The loop's records (:mod:`tmem.engine.records`); all but ``commands`` change in place.
     """
     rebuild = False
-    while counters.next_command[0] < commands.step.shape[0] and commands.step[counters.next_command[0]] <= k:
+    while commands_due(k, commands, counters):
         c = counters.next_command[0]
         kind = commands.kind[c]
         first = commands.ptr[c]
@@ -137,33 +157,34 @@ def corrected_positions(known, agents, law, run, neighbours):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _chunk_pushes(diff, m, n_axes, function, params):
-    """The pushes of ``m`` pairs, in place: ``diff[a]`` holds ``d_a = P*_j - P*_i`` on entry and the
-    push on agent ``i`` along axis ``a``, ``f(|d|) d_a / |d|``, on return (0 beyond reach).
-    ``diff[n_axes + a]`` holds ``P_j - P_i``; ``diff[2 n_axes]`` gets ``|P_j - P_i|^2`` for the
-    pairs within reach, ``inf`` for the others.  No branches: the compiler vectorises it."""
+def _chunk_pushes(chunks, w, m, n_axes, function, params):
+    """The pushes of ``m`` pairs, in place in the work space ``chunks[w]``: row ``a`` holds
+    ``d_a = P*_j - P*_i`` on entry and the push on agent ``i`` along axis ``a``, ``f(|d|) d_a / |d|``,
+    on return (0 beyond reach).  Row ``n_axes + a`` holds ``P_j - P_i``; row ``2 n_axes`` gets
+    ``|P_j - P_i|^2`` for the pairs within reach, ``inf`` for the others.  No branches: the compiler
+    vectorises it."""
     reach2 = params.reach * params.reach
     for t in range(m):
         r2 = 0.0
         for a in range(n_axes):
-            r2 += diff[a, t] * diff[a, t]
+            r2 += chunks[w, a, t] * chunks[w, a, t]
         inside = (r2 < reach2) & (r2 > 0.0)
         r = np.sqrt(r2)
         push = pair_control(function, r, 0, params) / r
         push = push if inside else 0.0
         dist2 = 0.0
         for a in range(n_axes):
-            dist2 += diff[n_axes + a, t] * diff[n_axes + a, t]
-            diff[a, t] *= push
-        diff[2 * n_axes, t] = dist2 if inside else np.inf
+            dist2 += chunks[w, n_axes + a, t] * chunks[w, n_axes + a, t]
+            chunks[w, a, t] *= push
+        chunks[w, 2 * n_axes, t] = dist2 if inside else np.inf
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _pushes_of(corrected, pairs, first, stop, box, function, params, u):
+def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, w):
     """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
-    the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach."""
+    the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
+    the work space."""
     n_axes = len(box)
-    diff = np.empty((2 * n_axes + 1, CHUNK))
     nearest2 = np.inf
     for begin in range(first, stop, CHUNK):
         m = min(CHUNK, stop - begin)
@@ -171,17 +192,17 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u):
             i = pairs[begin + t, 0]
             j = pairs[begin + t, 1]
             for a in range(n_axes):
-                diff[a, t] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
-                diff[n_axes + a, t] = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
-        _chunk_pushes(diff, m, n_axes, function, params)
+                chunks[w, a, t] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
+                chunks[w, n_axes + a, t] = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
+        _chunk_pushes(chunks, w, m, n_axes, function, params)
         for t in range(m):
-            nearest2 = min(nearest2, diff[2 * n_axes, t])
+            nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
         for t in range(m):
             i = pairs[begin + t, 0]
             j = pairs[begin + t, 1]
             for a in range(n_axes):
-                u[i, a] += diff[a, t]
-                u[j, a] -= diff[a, t]
+                u[i, a] += chunks[w, a, t]
+                u[j, a] -= chunks[w, a, t]
     return nearest2
 
 
@@ -208,9 +229,13 @@ def neighbour_pushes(agents, neighbours, law, params, run):
     pairs = neighbours.pairs
     block_ptr = neighbours.block_ptr
     block_nearest2 = neighbours.block_nearest2
-    for b in numba.prange(block_ptr.shape[0] - 1):
-        block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params, setpoint)
-    nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint)
+    chunks = neighbours.chunks
+    n_blocks = block_ptr.shape[0] - 1
+    for b in numba.prange(n_blocks):
+        block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params, setpoint,
+                                       chunks, b)  # fmt: skip
+    nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint,
+                          chunks, n_blocks)  # fmt: skip
     neighbours.closest[0] = min(neighbours.closest[0], nearest2, block_nearest2.min())
 
 
@@ -267,7 +292,7 @@ def formation_pairs(k, agents, pairs, law, params, run, events, counters):
     params : FunctionParams
         The interaction functions' parameters; each pair's own ``d_t`` replaces the scenario's.
     """
-    d = np.empty(len(run.box))
+    d = pairs.d
     for e in range(pairs.i.shape[0]):
         i = pairs.i[e]
         j = pairs.j[e]
