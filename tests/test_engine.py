@@ -122,3 +122,25 @@ def test_three_agents_on_a_line_interact_pairwise():
     np.testing.assert_allclose(tr.state[:, 1, 0, 0], 45.0, atol=1e-9)
     # The outer agents bounce back with their speeds.
     np.testing.assert_allclose(tr.state[-1, [0, 2], 0, 1], [-2.0, 2.0], atol=0.02)
+
+
+def test_each_agent_corrected_position_uses_its_own_gains():
+    """The P* stage (6) with a different row of gains per agent matches x . K_i / K_P,i row by row."""
+    from tmem.control import interaction_point
+    from tmem.engine.records import Agents, Law, Neighbours, Run
+    from tmem.engine.stages import corrected_positions
+
+    rng = np.random.default_rng(3)
+    n, axes = 5, 2
+    state = rng.normal(size=(n, axes, 4))
+    gains = rng.uniform(0.5, 2.0, size=(n, 4))
+    agents = Agents(state, state.copy(), np.ones(n, dtype=np.bool_), np.empty((n, axes, 2)), np.ones((n, axes)))
+    law = Law(gains, 0, 0, False, False, 0.2)
+    run = Run(10, 1, (0.0,) * axes, False, 1.0)
+    neighbours = Neighbours(np.empty((0, 2), dtype=np.uint32), 0, 0, np.zeros(2, dtype=np.int64), np.zeros((n, axes)),
+                            np.empty(1), np.full(1, np.inf), np.empty((2, 2 * axes + 1, 8)))  # fmt: skip
+    corrected_positions(state, agents, law, run, neighbours)
+    expected = np.stack([interaction_point(state[i], gains[i]) for i in range(n)])
+    np.testing.assert_allclose(agents.corrected[:, :, 0], expected, rtol=1e-13)
+    np.testing.assert_array_equal(agents.corrected[:, :, 1], state[:, :, 0])
+    assert not agents.setpoint.any()  # the sum of pushes starts from zero

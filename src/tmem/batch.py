@@ -73,7 +73,8 @@ def _run_batch(e0, n_steps, dt, command_step, hold, law, params, e_end, min_dist
     """Advance each case of ``e0`` (cases, 4) ``n_steps`` steps of ``dt`` under ``law`` with the
     functions' parameters ``params`` and the zero-order hold ``hold`` of the linear model; write each
     case's end, smallest distance, and the steps it first coupled and uncoupled (-1: never).
-    (Records are used inside the parallel loop only as arguments: see :class:`tmem.engine.records.Law`.)"""
+    (Records are used inside the parallel loop only as arguments: see :class:`tmem.engine.records.Law`.)
+    The two agents of a case are alike: ``P*`` (6) of their relative state uses the law's first row of gains."""
     gains = law.gains
     reach, d_t, eps, c_max = params.reach, params.d_t, law.eps, params.c_max
     function, couples, at_crossing = law.function, law.couples, law.at_crossing
@@ -104,7 +105,7 @@ def _run_batch(e0, n_steps, dt, command_step, hold, law, params, e_end, min_dist
                 running += 1
                 if k[c] == command_step:
                     armed[c] = 0
-                d = corrected_position(e_p[c], e_v[c], e_phi[c], e_om[c], gains)
+                d = corrected_position(e_p[c], e_v[c], e_phi[c], e_om[c], gains, 0)
                 r = abs(d)
                 lowest[c] = min(lowest[c], abs(e_p[c]))
                 # Free flight: uncoupled, out of reach, level (the tilt has died out).  Then
@@ -219,7 +220,7 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
     hold = model.step_params(sim.dt)
-    law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r))
+    law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r), 2)
     cases = len(positions)
     start = np.zeros((cases, 2, 4))
     start[:, :, 0] = positions

@@ -159,7 +159,7 @@ def interaction_point(x: np.ndarray, gains: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
-def corrected_position(p, v, phi, omega, gains):
+def corrected_position(p, v, phi, omega, gains, agent):
     """``P* = x . K / K_P`` (6) of one axis's state ``x = (p, v, phi, omega)``, in compiled code.
 
     The same quantity as :func:`interaction_point`, for the step loop and the batch; the sum runs
@@ -169,7 +169,10 @@ def corrected_position(p, v, phi, omega, gains):
     ----------
     p, v, phi, omega : float
         Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
-    gains : ndarray, shape (4,)
-        ``K`` from :func:`modal_gains`.
+    gains : ndarray, shape (agents, 4)
+        Each agent's ``K`` (:func:`modal_gains`); indexed in place, since a row taken out as an
+        array would cost a reference count at every agent.
+    agent : int
+        The row of the agent.
     """
-    return (p * gains[0] + v * gains[1] + phi * gains[2] + omega * gains[3]) / gains[0]
+    return (p * gains[agent, 0] + v * gains[agent, 1] + phi * gains[agent, 2] + omega * gains[agent, 3]) / gains[agent, 0]

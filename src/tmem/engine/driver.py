@@ -61,7 +61,7 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
     return steps
 
 
-def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
+def law_of(scenario: Scenario, gains: np.ndarray, n_agents: int) -> tuple[Law, FunctionParams]:
     """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters.
 
     Parameters
@@ -69,7 +69,9 @@ def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
     scenario : Scenario
         The scenario whose ``[interaction]`` table sets the law.
     gains : ndarray, shape (4,)
-        ``K`` placing the roots (5) (:func:`tmem.control.gains_for`).
+        ``K`` placing the roots (5) (:func:`tmem.control.gains_for`), every agent's.
+    n_agents : int
+        Agents of the run: the law holds a row of gains for each.
 
     Returns
     -------
@@ -79,7 +81,7 @@ def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
     ia = scenario.interaction
     couples = uses_coupling(ia.function)
     law = Law(
-        gains=gains,
+        gains=np.tile(gains, (n_agents, 1)),
         function=code(ia.function),
         neighbour_function=code("repulsion") if couples else code(ia.function),
         couples=couples,
@@ -256,7 +258,7 @@ def simulate(
     gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
     initial = build(scenario)
     run = _run_of(scenario, initial, record)
-    law, params = law_of(scenario, gains)
+    law, params = law_of(scenario, gains, initial.state.shape[0])
     swarm = _in_slots(scenario, initial, gains, record)
     x = swarm.agents.state
     lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], np.stack([swarm.pairs.i, swarm.pairs.j], axis=1), run.use_lists)

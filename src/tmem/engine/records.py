@@ -28,8 +28,9 @@ class Law(NamedTuple):
 
     Attributes
     ----------
-    gains : ndarray, shape (4,)
-        ``K = (K_P, K_V, K_phi, K_omega)``; ``P* = x . K / K_P`` (6).
+    gains : ndarray, shape (agents, 4)
+        Each agent's ``K = (K_P, K_V, K_phi, K_omega)``, in slot order; ``P* = x . K / K_P`` (6)
+        with the agent's own gains.  A scenario gives every agent the same row.
     function : int
         Registry code of the scenario's function, used by the formation pairs.
     neighbour_function : int
@@ -43,7 +44,7 @@ class Law(NamedTuple):
         The coupling window of (9) (m).
 
     The interaction functions' parameters travel beside it, as their own
-    record (:class:`~tmem.interaction.kernels.FunctionParams`: ``K_P``,
+    record (:class:`~tmem.interaction.kernels.FunctionParams`: the law's ``K_P``,
     ``R + R_j``, the scenario's ``d_t`` and ``c_max``): a parallel loop takes a
     record only as an argument of the function it runs in, not as a field.
     """

@@ -146,7 +146,7 @@ def corrected_positions(known, agents, law, run, neighbours):
     for i in numba.prange(known.shape[0]):
         shift2 = 0.0
         for a in range(n_axes):
-            corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains)
+            corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains, i)
             corrected[i, a, 1] = known[i, a, 0]
             setpoint[i, a] = 0.0  # the sum of pushes starts here
             if use_lists:
