@@ -20,6 +20,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
+from rich.text import Text
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__.split("\n")[0])
 console = Console(stderr=True)
@@ -59,6 +60,11 @@ def _fail(message: str) -> None:
     raise typer.Exit(2)
 
 
+def _say(text: str) -> None:
+    """Print ``text`` to standard output as it is: no markup, no highlighting, no wrapping (a path stays whole)."""
+    Console().print(text, markup=False, highlight=False, soft_wrap=True)
+
+
 def _number(value: float | None, form: str) -> str:
     return "—" if value is None else form.format(value)
 
@@ -67,7 +73,7 @@ def _summary_table(rows: dict[str, dict]) -> Table:
     table = Table("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
     for name, s in rows.items():
         table.add_row(
-            name, s["function"], "yes" if s["coupled"] else "no", _number(s["couple_time"], "{:.2f}"),
+            Text(name), s["function"], "yes" if s["coupled"] else "no", _number(s["couple_time"], "{:.2f}"),
             _number(s["uncouple_time"], "{:.2f}"), _number(s["rms_change_percent"], "{:+.3f}"),
             _number(s["min_distance"], "{:.2f}"),
         )  # fmt: skip
@@ -104,7 +110,7 @@ def run(
         progress.close()
         _fail(str(exc))
     Console().print(_summary_table({loaded.name or scenario.stem: summary}))
-    Console().print(f"written to {out}/")
+    _say(f"written to {out}/")
 
 
 @app.command()
@@ -131,7 +137,7 @@ def paper(
         _fail(str(exc))
     progress.close()
     Console().print(_summary_table(summaries))
-    Console().print(f"report: {out / 'report.md'}")
+    _say(f"report: {out / 'report.md'}")
 
 
 @app.command("animate")
@@ -155,13 +161,16 @@ def animate_command(
     max_frames : int
         Most frames; the recorded times are thinned evenly.
     """
+    for option, value in (("--fps", fps), ("--max-frames", max_frames)):
+        if value < 1:
+            _fail(f"{option}: must be at least 1, got {value}")
     from .animate import animate
 
     try:
         path = animate(run_dir, out, fps=fps, max_frames=max_frames)
     except (ValueError, OSError) as exc:
         _fail(str(exc))
-    Console().print(f"written {path}")
+    _say(f"written {path}")
 
 
 @app.command("sweep")

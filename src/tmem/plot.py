@@ -26,6 +26,7 @@ _EVENT_STYLE = {"couple": ("tab:green", "-"), "uncouple": ("tab:red", "-"), "com
 
 
 def _title(trajectory: Trajectory) -> str:
+    """The figure title; set it with ``parse_math=False``: a ``$`` in the scenario's name is a dollar, not mathtext."""
     s = trajectory.scenario
     name = f"{s.name}: " if s.name else ""
     return f"{name}{s.interaction.function} function, c_max = {s.interaction.c_max:g} rad"
@@ -62,7 +63,7 @@ def velocity_figure(trajectory: Trajectory):
     _mark_events(ax, trajectory)
     ax.set_xlabel("time, s")
     ax.set_ylabel("velocity, m/s" if one_axis else "speed, m/s")
-    ax.set_title(_title(trajectory))
+    ax.set_title(_title(trajectory), parse_math=False)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     return fig
@@ -90,7 +91,7 @@ def distance_figure(trajectory: Trajectory):
         top.axhline(d_t, color="tab:olive", linestyle="--", linewidth=1, label=f"d_t = {d_t:g} m")
     _mark_events(top, trajectory)
     top.set_ylabel("distance, m")
-    top.set_title(_title(trajectory))
+    top.set_title(_title(trajectory), parse_math=False)
     top.grid(alpha=0.3)
     top.legend(loc="best", fontsize=8)
     bottom.set_ylabel("F_en")
@@ -121,7 +122,7 @@ def formation_figure(trajectory: Trajectory):
     _mark_events(ax, trajectory)
     ax.set_xlabel("time, s")
     ax.set_ylabel("| distance - d_t |, m (coupled pairs)")
-    ax.set_title(f"formation of {len(trajectory.pairs)} pairs; " + _title(trajectory))
+    ax.set_title(f"formation of {len(trajectory.pairs)} pairs; " + _title(trajectory), parse_math=False)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     return fig
