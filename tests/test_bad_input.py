@@ -297,3 +297,20 @@ def test_a_list_of_the_wrong_size_says_how_many_and_suggests_space_axes(case, tm
     assert result.exit_code == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].endswith(f"{field}: {reason}"), lines
+
+
+@pytest.mark.parametrize("when", [0.0, 0.5])
+def test_every_agent_removed_writes_null_not_infinity(when, tmp_path, runner):
+    """Every agent removed (at the start, or later): summary.json stays valid JSON, with null where no agent flies."""
+    import json
+
+    short = GOOD.replace("duration = 60.0", "duration = 1.0").replace("dt = 0.0001", "dt = 0.001")
+    head = short.split("[[commands]]")[0]
+    removals = "".join(f'[[commands]]\ntime = {when}\naction = "remove"\nagent = {a}\n' for a in (0, 1))
+    (tmp_path / "gone.toml").write_text(head + removals)
+    result = runner.invoke(app, ["run", str(tmp_path / "gone.toml"), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    text = (tmp_path / "o" / "summary.json").read_text()
+    s = json.loads(text, parse_constant=lambda name: pytest.fail(f"{name} in summary.json"))
+    assert s["rms_velocity_final"] is None and s["rms_change_percent"] is None and s["final_distance"] is None
+    assert (s["pairs"][0]["min_distance"] is None) == (when == 0.0)  # never measured when removed at once

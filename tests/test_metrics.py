@@ -175,3 +175,22 @@ def test_formations_report_coupled_from_the_start_and_after_a_loss(kind, n):
     assert s["pairs_coupled_at_end"] == int(np.sum(tr.flag[-1] == 1))  # the last record is the end
     assert s["uncouple_time"] == (pytest.approx(1.0) if lost else None)
     assert s["rms_change_while_coupled"] is True
+
+
+def test_the_table2_pair_left_coupled_is_flagged_in_summary_and_table(tmp_path):
+    """Without its uncouple command the pair is still coupled at the end: its RMS change is marked as swinging."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from tmem.cli import SWINGS, app
+
+    text = tmem.preset("fig9").to_toml().split("[[commands]]")[0]
+    text = text.replace("duration = 60.0", "duration = 6.0").replace("dt = 0.0001", "dt = 0.001")
+    (tmp_path / "coupled.toml").write_text(text)
+    result = CliRunner().invoke(app, ["run", str(tmp_path / "coupled.toml"), "--out", str(tmp_path / "o")], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert s["coupled"] and s["pairs_coupled_at_end"] == 1 and s["rms_change_while_coupled"] is True
+    assert "yes, 1/1 at end" in result.stdout and f"{s['rms_change_percent']:+.3f} *" in result.stdout
+    assert SWINGS in " ".join(result.stdout.split())
