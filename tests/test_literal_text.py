@@ -1,6 +1,7 @@
 """What a user typed is printed and drawn as typed: rich markup and mathtext in names and paths are text."""
 
 import json
+import warnings
 
 import pytest
 from typer.testing import CliRunner
@@ -13,13 +14,13 @@ SHORT = (
     tmem.preset("fig9").to_toml()
     .replace("duration = 60.0", "duration = 2.0").replace("dt = 0.0001", "dt = 0.001").replace("time = 29.0", "time = 1.0")
 )  # fmt: skip
-NAMES = ["[/bold] oops", "d[/x]", "[bold]y", "[red]x[/red]", "$x^$", "$\\frac{", "a $b$ c", "50% [link=x]y"]
+NAMES = ["[/bold] oops", "d[/x]", "[bold]y", "[red]x[/red]", "$x^$", "$\\frac{", "a $b$ c", "50% [link=x]y", "日本語", "🚀 swarm"]
 
 
 def _scenario(tmp_path, name: str):
     assert 'name = "fig9"' in SHORT
     path = tmp_path / "s.toml"
-    path.write_text(SHORT.replace('name = "fig9"', f"name = {json.dumps(name)}"))
+    path.write_text(SHORT.replace('name = "fig9"', f"name = {json.dumps(name, ensure_ascii=False)}"))
     return path
 
 
@@ -27,8 +28,11 @@ def _scenario(tmp_path, name: str):
 def test_a_name_is_printed_and_plotted_as_written(tmp_path, name):
     out = tmp_path / "out"
     wide = {"COLUMNS": "200"}  # so that the table does not wrap the name in its cell
-    result = CliRunner().invoke(app, ["run", str(_scenario(tmp_path, name)), "--out", str(out)], env=wide)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = CliRunner().invoke(app, ["run", str(_scenario(tmp_path, name)), "--out", str(out)], env=wide)
     assert result.exit_code == 0, result.output
+    assert not [w for w in caught if "missing from font" in str(w.message)]  # a box per glyph, not a warning
     assert f" {name} " in result.stdout  # in the table, literally
     assert json.loads((out / "summary.json").read_text())["scenario"] == name
     assert {"velocity.png", "distance.png"} <= {p.name for p in out.iterdir()}

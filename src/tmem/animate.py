@@ -26,6 +26,7 @@ from __future__ import annotations
 import gc
 import sys
 import tomllib
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -365,7 +366,9 @@ def animate(
     check_file(out, label=label)
 
     shown, cross = _shown_and_removed(run)
-    fig, moving = _figure(run, shown, dpi)
+    with warnings.catch_warnings():  # a name in a script the font lacks is drawn as boxes, without a warning per glyph
+        warnings.filterwarnings("ignore", message=r"Glyph \d+ .* missing from font", category=UserWarning)
+        fig, moving = _figure(run, shown, dpi)
     ax = fig.axes[0]
     background = fig.canvas.copy_from_bbox(fig.bbox)
     draw_dashed = np.count_nonzero(run.flag == 0, axis=1).max(initial=0) <= MAX_DASHED_EDGES

@@ -9,6 +9,7 @@ formation's pairs against time.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -20,6 +21,8 @@ import numpy as np  # noqa: E402
 from . import metrics  # noqa: E402
 from .engine import Trajectory  # noqa: E402
 
+#: Matplotlib's warning for a character its font lacks (a name in CJK, an emoji).
+MISSING_GLYPH = r"Glyph \d+ .* missing from font"
 #: Most agents or pairs drawn one by one in a figure.
 MAX_DRAWN = 8
 _EVENT_STYLE = {"couple": ("tab:green", "-"), "uncouple": ("tab:red", "-"), "command": ("0.4", ":")}
@@ -158,7 +161,9 @@ def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
     for name, make in makers:
         fig = make(trajectory)
         path = Path(directory) / name
-        fig.savefig(path, dpi=120)
+        with warnings.catch_warnings():  # a name in a script the font lacks is drawn as boxes, without a warning per glyph
+            warnings.filterwarnings("ignore", message=MISSING_GLYPH, category=UserWarning)
+            fig.savefig(path, dpi=120)
         plt.close(fig)
         paths.append(path)
     return paths
