@@ -1,5 +1,8 @@
 """Animation of a 2-D run, from small synthetic ``trajectory.nc`` files."""
 
+import subprocess
+import sys
+
 import matplotlib.animation
 import numpy as np
 import pytest
@@ -94,6 +97,62 @@ def test_refuses_runs_that_are_not_2d(tmp_path, n_axes, words):
 def test_missing_trajectory(tmp_path):
     with pytest.raises(ValueError, match="animate: no trajectory.nc in"):
         animate(tmp_path)
+
+
+def test_missing_folder_is_called_missing(tmp_path):
+    """Not "no trajectory.nc in ...": the folder itself is not there."""
+    with pytest.raises(ValueError) as error:
+        animate(tmp_path / "nowhere")
+    assert str(error.value) == f"animate: {tmp_path / 'nowhere'}: no such folder"
+
+
+def _truncated(data: bytes) -> bytes:
+    return data[: len(data) // 2]
+
+
+def _header_flipped(data: bytes) -> bytes:
+    """The version byte of the last object header (a variable's) flipped: h5py raised KeyError."""
+    at = data.rindex(b"OHDR") + 4
+    return data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
+
+
+def _superblock_flipped(data: bytes) -> bytes:
+    return bytes([data[0] ^ 0x01]) + data[1:]
+
+
+@pytest.mark.parametrize("damage", [_truncated, _header_flipped, _superblock_flipped], ids=lambda f: f.__name__[1:])
+def test_damaged_trajectory_is_refused_naming_the_file(tmp_path, damage):
+    path = _write(tmp_path) / "trajectory.nc"
+    path.write_bytes(damage(path.read_bytes()))
+    with pytest.raises(ValueError) as error:
+        animate(tmp_path, max_frames=3)
+    message = str(error.value)
+    assert message.startswith(f"animate: {path}: cannot be read as a run's trajectory (") and "\n" not in message
+    assert not (tmp_path / "animation.gif").exists()
+
+
+def test_damaged_trajectory_gives_one_line_and_exit_2_from_the_command(tmp_path):
+    """The real command: no traceback, and no "Exception ignored" from the half-opened file."""
+    path = _write(tmp_path) / "trajectory.nc"
+    path.write_bytes(_header_flipped(path.read_bytes()))
+    proc = subprocess.run(
+        [sys.executable, "-c", "from tmem.cli import main; main()", "animate", str(tmp_path)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "trajectory.nc: cannot be read" in lines[0], proc.stderr
+    assert proc.stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == ["trajectory.nc"]
+
+
+@pytest.mark.parametrize("name", ["$x^$", "$\\frac{", "[/bold] oops"])
+def test_a_name_is_drawn_as_written(tmp_path, name, monkeypatch):
+    """Mathtext in the scenario's name is text in the title, not a formula that fails to parse."""
+    import json
+
+    monkeypatch.setattr(sys.modules[__name__], "SCENARIO", f"name = {json.dumps(name)}\n" + SCENARIO.split("\n", 1)[1])
+    out = animate(_write(tmp_path), max_frames=2)
+    assert out.is_file()
 
 
 def test_mp4_without_ffmpeg(tmp_path, monkeypatch):

@@ -262,3 +262,55 @@ def test_console_script_exits_2_without_traceback(tmp_path):
     assert proc.stderr.count("\n") == 1 and "interaction.d_t" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert not Path(tmp_path / "o").exists()
+
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.mark.parametrize("sweep", sorted((EXAMPLES / "sweeps").glob("*.toml")), ids=lambda p: p.name)
+def test_a_sweep_file_given_to_run_is_named_a_sweep_file(sweep, tmp_path, runner):
+    """One line that says what it is and what to use, not a line per sweep key."""
+    result = runner.invoke(app, ["run", str(sweep), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "is a sweep file" in lines[0] and "tmem sweep" in lines[0], lines
+    assert "unknown key" not in lines[0] and not (tmp_path / "out").exists()
+
+
+PER_AXIS = {
+    "2-D position on one axis": (edit("position = 0.0", "position = [0.0, 1.0]"), "agents[1].position",
+                                 "needs 1 value, one per axis (space.axes = 1), got 2; for a 2-D run set axes = 2 in [space]"),
+    "3-D velocity on one axis": (edit("velocity = 3.0", "velocity = [3.0, 0.0, 0.0]"), "agents[1].velocity",
+                                 "needs 1 value, one per axis (space.axes = 1), got 3; for a 3-D run set axes = 3 in [space]"),
+    "2-D box in 3-D": (SWARM.replace("axes = 2", "axes = 3\nbox = [500.0, 500.0]"), "space.box",
+                       "needs 3 values, one per axis (space.axes = 3), got 2; for a 2-D run set axes = 2 in [space]"),
+    "four values": (SWARM + "velocity = [1.0, 2.0, 3.0, 4.0]\n", "formation.velocity",
+                    "needs 2 values, one per axis (space.axes = 2), got 4"),
+}
+
+
+@pytest.mark.parametrize("case", PER_AXIS, ids=list(PER_AXIS))
+def test_a_list_of_the_wrong_size_says_how_many_and_suggests_space_axes(case, tmp_path, runner):
+    text, field, reason = PER_AXIS[case]
+    (tmp_path / "bad.toml").write_text(text)
+    result = runner.invoke(app, ["run", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].endswith(f"{field}: {reason}"), lines
+
+
+@pytest.mark.parametrize("when", [0.0, 0.5])
+def test_every_agent_removed_writes_null_not_infinity(when, tmp_path, runner):
+    """Every agent removed (at the start, or later): summary.json stays valid JSON, with null where no agent flies."""
+    import json
+
+    short = GOOD.replace("duration = 60.0", "duration = 1.0").replace("dt = 0.0001", "dt = 0.001")
+    head = short.split("[[commands]]")[0]
+    removals = "".join(f'[[commands]]\ntime = {when}\naction = "remove"\nagent = {a}\n' for a in (0, 1))
+    (tmp_path / "gone.toml").write_text(head + removals)
+    result = runner.invoke(app, ["run", str(tmp_path / "gone.toml"), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    text = (tmp_path / "o" / "summary.json").read_text()
+    s = json.loads(text, parse_constant=lambda name: pytest.fail(f"{name} in summary.json"))
+    assert s["rms_velocity_final"] is None and s["rms_change_percent"] is None and s["final_distance"] is None
+    assert (s["pairs"][0]["min_distance"] is None) == (when == 0.0)  # never measured when removed at once

@@ -370,13 +370,13 @@ def test_bad_sweep(name, tmp_path, runner):
 # -- animate ----------------------------------------------------------------------------------------------
 
 ANIMATE_CASES = {
-    "missing run": (lambda d: ["animate", str(d / "nowhere")], "nowhere"),
+    "missing run": (lambda d: ["animate", str(d / "nowhere")], "nowhere: no such folder"),
     "empty folder": (lambda d: (d / "empty").mkdir() or ["animate", str(d / "empty")], "empty"),
     "a file for the run": (lambda d: (d / "afile").write_text("x") and ["animate", str(d / "afile")], "afile"),
-    "fps zero": (lambda d: ["animate", str(d / "nowhere"), "--fps", "0"], "fps"),
-    "fps negative": (lambda d: ["animate", str(d / "nowhere"), "--fps", "-3"], "fps"),
-    "max_frames zero": (lambda d: ["animate", str(d / "nowhere"), "--max-frames", "0"], "max_frames"),
-    "max_frames negative": (lambda d: ["animate", str(d / "nowhere"), "--max-frames", "-1"], "max_frames"),
+    "fps zero": (lambda d: ["animate", str(d / "nowhere"), "--fps", "0"], "--fps: must be at least 1, got 0"),
+    "fps negative": (lambda d: ["animate", str(d / "nowhere"), "--fps", "-3"], "--fps: must be at least 1, got -3"),
+    "max_frames zero": (lambda d: ["animate", str(d / "nowhere"), "--max-frames", "0"], "--max-frames: must be at least 1"),
+    "max_frames negative": (lambda d: ["animate", str(d / "nowhere"), "--max-frames", "-1"], "--max-frames: must be"),
 }
 
 

@@ -86,3 +86,111 @@ def test_nearest_distance_matches_brute_force_in_a_periodic_box():
     np.fill_diagonal(brute, np.inf)
     assert nearest_distance(points, active, box) == pytest.approx(brute.min(), rel=1e-12)
     assert nearest_distance(points, active, np.zeros(2)) >= brute.min()
+
+
+def started_coupled(trajectory):
+    """The same trajectory, its pair coupled from the start (as a formation's pairs are)."""
+    import dataclasses
+
+    initial = dataclasses.replace(trajectory.initial, flag=np.ones_like(trajectory.initial.flag))
+    return dataclasses.replace(trajectory, initial=initial)
+
+
+# (distance, flag, events, started coupled) -> (coupled, at start, ever, at end, couple_time, uncouple_time)
+COUPLING = {
+    "never": ([60, 50, 45, 50], [0, 0, 0, 0], [], False, (False, 0, 0, 0, None, None)),
+    "Table 2 pair, uncoupled by command": (
+        [50, 36, 33, 41], [0, 1, 1, 0],
+        [Event(1.0, "couple", (0, 1)), Event(2.0, "command", (0, 1), "uncouple"), Event(3.0, "uncouple", (0, 1))],
+        False, (True, 0, 1, 0, 1.0, 3.0),
+    ),
+    "Table 2 pair, no command": ([50, 36, 33, 36], [0, 1, 1, 1], [Event(1.0, "couple", (0, 1))], False,
+                                 (True, 0, 1, 1, 1.0, None)),
+    "formation pair, coupled throughout": ([35, 36, 34, 35], [1, 1, 1, 1], [], True, (True, 1, 1, 1, 0.0, None)),
+    "formation pair losing an agent": ([35, 36, 34, 35], [1, 1, 0, 0], [Event(2.0, "uncouple", (0, 1))], True,
+                                       (True, 1, 1, 0, 0.0, 2.0)),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", COUPLING, ids=list(COUPLING))
+def test_coupled_means_coupled_at_any_time_including_from_the_start(case):
+    distance, flag, events, start, expected = COUPLING[case]
+    tr = made(distance, flag, events)
+    s = summarize(started_coupled(tr) if start else tr)
+    keys = ("coupled", "pairs_coupled_at_start", "pairs_coupled_ever", "pairs_coupled_at_end", "couple_time", "uncouple_time")
+    assert tuple(s[k] for k in keys) == expected
+    assert s["pairs"][0]["coupled_at"] == expected[4] and s["pairs"][0]["coupled_at_end"] == bool(expected[3])
+    # The RMS change is flagged exactly when pairs are still coupled at the end.
+    assert s["rms_change_while_coupled"] is bool(expected[3])
+
+
+def test_every_agent_gone_gives_null_not_inf_or_nan():
+    """summary.json stays valid JSON: null where a figure does not exist."""
+    import dataclasses
+    import json
+
+    tr = made([50, 50], [0, 0], [], velocities=np.array([[3.0, -1.5], [3.0, -1.5]]))
+    tr = dataclasses.replace(tr, final_active=np.zeros(2, dtype=bool), min_distance=np.array([np.inf]))
+    s = summarize(tr)
+    assert s["rms_velocity_final"] is None and s["rms_change_percent"] is None  # not -100 %: no agent flies
+    assert s["min_distance"] is None and s["pairs"][0]["min_distance"] is None and s["final_distance"] is None
+    json.dumps(s, allow_nan=False)
+
+
+def test_table_marks_an_rms_change_taken_while_coupled():
+    from rich.console import Console
+
+    from tmem.cli import SWINGS, _summary_table
+
+    rows = {}
+    for name, (distance, flag, events, start, _) in COUPLING.items():
+        tr = made(distance, flag, events, velocities=np.array([[-1.5, 3.0]] * len(distance)))
+        rows[name] = summarize(started_coupled(tr) if start else tr)
+    console = Console(width=300, record=True)
+    console.print(_summary_table(rows))
+    text = console.export_text()
+    lines = {name: next(line for line in text.splitlines() if name in line) for name in rows}
+    assert "│ no " in lines["never"] and "yes, 1/1 at end" in lines["formation pair, coupled throughout"]
+    assert "yes, 0/1 at end" in lines["formation pair losing an agent"]
+    assert " * " in lines["Table 2 pair, no command"] and " * " not in lines["Table 2 pair, uncoupled by command"]
+    assert SWINGS in text
+
+
+@pytest.mark.parametrize("kind, n", [("triangle", None), ("chain", 4), ("ring", 6)])
+def test_formations_report_coupled_from_the_start_and_after_a_loss(kind, n):
+    """A formation starts coupled (no couple event) and a ring losing an agent keeps the rest."""
+    from tmem.scenario import from_dict
+
+    formation = {"kind": kind, "velocity": [3.0, 0.0], "jitter": 1.0, "seed": 1} | ({"n": n} if n else {})
+    data = {"space": {"axes": 2}, "interaction": {"function": "improved"}, "formation": formation,
+            "simulation": {"duration": 3.0}}  # fmt: skip
+    if kind == "ring":
+        data["commands"] = [{"time": 1.0, "action": "remove", "agent": 2}]
+    tr = tmem.simulate(from_dict(data))
+    s = summarize(tr)
+    n_pairs = len(tr.pairs)
+    lost = 2 if kind == "ring" else 0
+    assert (s["coupled"], s["couple_time"]) == (True, 0.0)
+    assert (s["pairs_coupled_at_start"], s["pairs_coupled_ever"], s["pairs_coupled_at_end"]) == (n_pairs, n_pairs, n_pairs - lost)
+    assert s["pairs_coupled_at_end"] == int(np.sum(tr.flag[-1] == 1))  # the last record is the end
+    assert s["uncouple_time"] == (pytest.approx(1.0) if lost else None)
+    assert s["rms_change_while_coupled"] is True
+
+
+def test_the_table2_pair_left_coupled_is_flagged_in_summary_and_table(tmp_path):
+    """Without its uncouple command the pair is still coupled at the end: its RMS change is marked as swinging."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from tmem.cli import SWINGS, app
+
+    text = tmem.preset("fig9").to_toml().split("[[commands]]")[0]
+    text = text.replace("duration = 60.0", "duration = 6.0").replace("dt = 0.0001", "dt = 0.001")
+    (tmp_path / "coupled.toml").write_text(text)
+    result = CliRunner().invoke(app, ["run", str(tmp_path / "coupled.toml"), "--out", str(tmp_path / "o")], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert s["coupled"] and s["pairs_coupled_at_end"] == 1 and s["rms_change_while_coupled"] is True
+    assert "yes, 1/1 at end" in result.stdout and f"{s['rms_change_percent']:+.3f} *" in result.stdout
+    assert SWINGS in " ".join(result.stdout.split())

@@ -23,7 +23,12 @@ over it, so a 400-frame GIF of 20 agents takes a few seconds.
 
 from __future__ import annotations
 
+import gc
+import sys
 import tomllib
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -79,23 +84,77 @@ def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return k, ids[k] == wanted
 
 
+class _Refused(ValueError):
+    """A readable trajectory that cannot be animated; its message is final."""
+
+
+def _trajectory_path(run_dir: Path) -> Path:
+    """``run_dir``'s ``trajectory.nc`` (or ``run_dir`` itself, an ``.nc`` file); refuse one that is not there."""
+    if run_dir.suffix == ".nc":
+        if not run_dir.is_file():
+            raise ValueError(f"animate: {run_dir}: {'is not a file' if run_dir.exists() else 'no such file'}")
+        return run_dir
+    if not run_dir.exists():
+        raise ValueError(f"animate: {run_dir}: no such folder")
+    if not run_dir.is_dir():
+        raise ValueError(f"animate: {run_dir}: is a file, not a run folder; give the folder tmem run wrote")
+    if not (run_dir / "trajectory.nc").is_file():
+        raise ValueError(f"animate: no trajectory.nc in {run_dir}; give a folder written by tmem run")
+    return run_dir / "trajectory.nc"
+
+
+@contextmanager
+def _quiet_unraisable() -> Iterator[None]:
+    """Silence errors raised while objects are freed (h5netcdf's half-opened file on a damaged one)."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = hook
+
+
+def _reason(exc: Exception) -> str:
+    """An exception as a short phrase of one line: its message, or its class when it has none."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    text = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
 def _load(run_dir: Path, max_frames: int) -> _Run:
-    """Read the frames and agents to draw from ``trajectory.nc``; refuse runs that are not 2-D."""
-    path = run_dir if run_dir.suffix == ".nc" else run_dir / "trajectory.nc"
-    if not path.is_file():
-        raise ValueError(f"animate: no trajectory.nc in {run_dir}")
+    """Read the frames and agents to draw; a damaged or truncated ``trajectory.nc`` is refused in one line.
+
+    A damaged file fails in h5py, h5netcdf, xarray or NumPy, each in its own way (``OSError``,
+    ``KeyError``, ``RuntimeError``, ``MemoryError``...): any such failure while reading names the
+    file and the reason.
+    """
+    path = _trajectory_path(run_dir)
+    message = None
+    with _quiet_unraisable():
+        try:
+            return _read(path, max_frames)
+        except _Refused:
+            raise
+        except Exception as exc:  # noqa: BLE001 - see the docstring
+            message = f"animate: {path}: cannot be read as a run's trajectory ({_reason(exc)})"
+    raise ValueError(message)  # outside the handler: the failed file is freed, quietly, before this
+
+
+def _read(path: Path, max_frames: int) -> _Run:
+    """Read the frames and agents to draw from ``path``; refuse runs that are not 2-D."""
     with xr.open_dataset(path, engine="h5netcdf") as ds:
         n_axes = ds.sizes.get("axis", 0)
         if n_axes != 2:
             noun = "axis" if n_axes == 1 else "axes"
-            raise ValueError(f"animate: the run has {n_axes} {noun}; only 2-D runs can be animated")
+            raise _Refused(f"animate: the run has {n_axes} {noun}; only 2-D runs can be animated")
         if ds.sizes["time"] == 0 or ds.sizes["agent"] == 0:
-            raise ValueError("animate: the run has no recorded times or agents")
+            raise _Refused("animate: the run has no recorded times or agents")
         try:
             scenario = tomllib.loads(ds.attrs["scenario"])
             radius = float(scenario["interaction"]["radius"])
         except (KeyError, TypeError, ValueError) as error:
-            raise ValueError("animate: the run's scenario attribute gives no interaction.radius") from error
+            raise _Refused(f"animate: {path}: the run's scenario attribute gives no interaction.radius") from error
         sub = ds.isel(time=_evenly(ds.sizes["time"], max_frames), agent=_evenly(ds.sizes["agent"], MAX_AGENTS_DRAWN))
         pos = sub["P"].values.astype(float)
         active = sub["active"].values.astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
@@ -190,7 +249,8 @@ def _figure(run: _Run, shown: np.ndarray, dpi: int) -> tuple[Figure, dict]:
     ax.set(aspect="equal", xlabel="x, m", ylabel="y, m")
     ax.grid(alpha=0.3)
     n_drawn = shown.shape[1]
-    ax.set_title(f"{run.name + ': ' if run.name else ''}{n_drawn} agents drawn, R = {run.radius:g} m")
+    title = f"{run.name + ': ' if run.name else ''}{n_drawn} agents drawn, R = {run.radius:g} m"
+    ax.set_title(title, parse_math=False)  # the name as written: a ``$`` is not mathtext
 
     colors = [f"C{i % 10}" for i in range(n_drawn)] if n_drawn <= 20 else "tab:blue"
     # Black at the set distance (or with no d_t known), blue when closer, red when farther.
@@ -286,7 +346,8 @@ def animate(
     Raises
     ------
     ValueError
-        With a one-line message: no ``trajectory.nc``, a run that is not 2-D,
+        With a one-line message: a missing folder, no ``trajectory.nc``, one
+        that cannot be read (damaged or truncated), a run that is not 2-D,
         no ``interaction.radius`` in the scenario, an output that is neither
         ``.gif`` nor ``.mp4``, or MP4 without ffmpeg; an ``out`` that
         exists and was not written by ``animate`` (:func:`tmem.outputs.check_file`).
@@ -295,8 +356,9 @@ def animate(
     when complete: an interrupted animation leaves nothing at ``out``.
     """
     run_dir = Path(run_dir)
-    if fps <= 0 or max_frames < 1 or dpi <= 0:
-        raise ValueError("animate: fps, max_frames and dpi must be positive")
+    for name, value in (("fps", fps), ("max_frames", max_frames), ("dpi", dpi)):
+        if not value > 0:
+            raise ValueError(f"animate: {name} must be positive, got {value}")
     label = "--out " if out is not None else ""
     out = Path(out) if out is not None else (run_dir.parent if run_dir.suffix == ".nc" else run_dir) / "animation.gif"
     run = _load(run_dir, max_frames)
@@ -304,7 +366,9 @@ def animate(
     check_file(out, label=label)
 
     shown, cross = _shown_and_removed(run)
-    fig, moving = _figure(run, shown, dpi)
+    with warnings.catch_warnings():  # a name in a script the font lacks is drawn as boxes, without a warning per glyph
+        warnings.filterwarnings("ignore", message=r"Glyph \d+ .* missing from font", category=UserWarning)
+        fig, moving = _figure(run, shown, dpi)
     ax = fig.axes[0]
     background = fig.canvas.copy_from_bbox(fig.bbox)
     draw_dashed = np.count_nonzero(run.flag == 0, axis=1).max(initial=0) <= MAX_DASHED_EDGES

@@ -19,7 +19,8 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-from rich.table import Table
+from rich.table import Column, Table
+from rich.text import Text
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__.split("\n")[0])
 console = Console(stderr=True)
@@ -59,18 +60,39 @@ def _fail(message: str) -> None:
     raise typer.Exit(2)
 
 
+def _say(text: str) -> None:
+    """Print ``text`` to standard output as it is: no markup, no highlighting, no wrapping (a path stays whole)."""
+    Console().print(text, markup=False, highlight=False, soft_wrap=True)
+
+
 def _number(value: float | None, form: str) -> str:
     return "—" if value is None else form.format(value)
 
 
+#: Under the table when a run ended with pairs coupled.
+SWINGS = "* pairs still coupled at the end: ΔRMS is an instantaneous value that swings with their oscillation"
+
+
+def _coupled_cell(s: dict) -> str:
+    """``no``, or ``yes`` with how many of the pairs were coupled at the end (a formation starts coupled)."""
+    if not s["coupled"]:
+        return "no"
+    return f"yes, {s['pairs_coupled_at_end']}/{len(s['pairs'])} at end"
+
+
 def _summary_table(rows: dict[str, dict]) -> Table:
-    table = Table("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
+    """The runs' headline figures, one row each; ΔRMS marked ``*`` where pairs were still coupled at the end."""
+    headers = ("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
+    table = Table(*(Column(h, overflow="fold") for h in headers))  # whole names, folded, not cut with "…"
     for name, s in rows.items():
+        swings = s["rms_change_while_coupled"] and s["rms_change_percent"] is not None
         table.add_row(
-            name, s["function"], "yes" if s["coupled"] else "no", _number(s["couple_time"], "{:.2f}"),
-            _number(s["uncouple_time"], "{:.2f}"), _number(s["rms_change_percent"], "{:+.3f}"),
+            Text(name), s["function"], _coupled_cell(s), _number(s["couple_time"], "{:.2f}"),
+            _number(s["uncouple_time"], "{:.2f}"), _number(s["rms_change_percent"], "{:+.3f}") + (" *" if swings else ""),
             _number(s["min_distance"], "{:.2f}"),
         )  # fmt: skip
+        if swings:
+            table.caption, table.caption_justify = SWINGS, "left"
     return table
 
 
@@ -104,7 +126,7 @@ def run(
         progress.close()
         _fail(str(exc))
     Console().print(_summary_table({loaded.name or scenario.stem: summary}))
-    Console().print(f"written to {out}/")
+    _say(f"written to {out}/")
 
 
 @app.command()
@@ -131,7 +153,7 @@ def paper(
         _fail(str(exc))
     progress.close()
     Console().print(_summary_table(summaries))
-    Console().print(f"report: {out / 'report.md'}")
+    _say(f"report: {out / 'report.md'}")
 
 
 @app.command("animate")
@@ -155,13 +177,16 @@ def animate_command(
     max_frames : int
         Most frames; the recorded times are thinned evenly.
     """
+    for option, value in (("--fps", fps), ("--max-frames", max_frames)):
+        if value < 1:
+            _fail(f"{option}: must be at least 1, got {value}")
     from .animate import animate
 
     try:
         path = animate(run_dir, out, fps=fps, max_frames=max_frames)
     except (ValueError, OSError) as exc:
         _fail(str(exc))
-    Console().print(f"written {path}")
+    _say(f"written {path}")
 
 
 @app.command("sweep")

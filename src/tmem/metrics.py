@@ -60,15 +60,51 @@ def _first(times: list[float]) -> float | None:
     return min(times) if times else None
 
 
+def _finite(value: float) -> float | None:
+    """``value`` as a float, or ``None`` (JSON ``null``) where it is not a finite number."""
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def coupling_states(trajectory: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Whether each pair was coupled (``F_en = 1``) at the start, at any time, and at the end.
+
+    Replayed from the starting flags (formation pairs may start coupled, with no
+    ``couple`` event) and the ``couple`` / ``uncouple`` events, so exact whatever
+    was recorded.  A pair that loses an agent uncouples then.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+
+    Returns
+    -------
+    start, ever, end : ndarray, shape (pairs,), bool
+    """
+    start = np.asarray(trajectory.initial.flag) == 1
+    ever, end = start.copy(), start.copy()
+    index = {tuple(pair): p for p, pair in enumerate(trajectory.pairs.tolist())}
+    for e in trajectory.events:  # in time order
+        p = index.get(e.agents) if e.kind in ("couple", "uncouple") else None
+        if p is not None:
+            end[p] = e.kind == "couple"
+            ever[p] |= end[p]
+    return start, ever, end
+
+
 def pair_summary(trajectory: Trajectory, p: int) -> dict:
     """Per-pair figures: coupling and uncoupling times, separation, distances, oscillation, errors.
 
-    ``separated_at`` is the first recorded time after the pair uncoupled at
-    which its distance reaches ``R + R_j`` (the spheres no longer intersect):
-    the paper's "actual disconnection".  ``oscillation_amplitude`` is half the
-    peak-to-peak distance over the recorded samples with ``F_en = 1``;
-    ``distance_error`` the mean, RMS and largest ``|distance - d_t|`` over the
-    same samples.
+    ``coupled_at`` is when the pair first coupled, 0 if it started coupled;
+    ``coupled_at_end`` whether it was coupled at the end.  ``separated_at`` is
+    the first recorded time after the pair uncoupled at which its distance
+    reaches ``R + R_j`` (the spheres no longer intersect): the paper's "actual
+    disconnection".  ``oscillation_amplitude`` is half the peak-to-peak
+    distance over the recorded samples with ``F_en = 1``; ``distance_error``
+    the mean, RMS and largest ``|distance - d_t|`` over the same samples.
+    ``None`` (JSON ``null``) where a figure does not exist: never coupled,
+    never measured (an agent removed before the first step).
 
     Parameters
     ----------
@@ -79,7 +115,9 @@ def pair_summary(trajectory: Trajectory, p: int) -> dict:
     """
     agents = tuple(int(a) for a in trajectory.pairs[p])
     events = [e for e in trajectory.events if e.agents == agents]
-    coupled_at = _first([e.time for e in events if e.kind == "couple"])
+    started = bool(trajectory.initial.flag[p] == 1)
+    coupled_at = 0.0 if started else _first([e.time for e in events if e.kind == "couple"])
+    changes = [e.kind for e in events if e.kind in ("couple", "uncouple")]
     uncoupled_at = _first([e.time for e in events if e.kind == "uncouple"])
     dist = trajectory.pair_distance[:, p]
     separated_at = None
@@ -92,10 +130,11 @@ def pair_summary(trajectory: Trajectory, p: int) -> dict:
         "agents": list(agents),
         "d_t": float(trajectory.d_t[p]),
         "coupled_at": coupled_at,
+        "coupled_at_end": changes[-1] == "couple" if changes else started,
         "uncoupled_at": uncoupled_at,
         "separated_at": separated_at,
-        "min_distance": float(trajectory.min_distance[p]),
-        "final_distance": float(dist[-1]) if len(dist) else None,
+        "min_distance": _finite(trajectory.min_distance[p]),
+        "final_distance": _finite(dist[-1]) if len(dist) else None,
         "mean_distance_coupled": float(while_coupled.mean()) if while_coupled.size else None,
         "oscillation_amplitude": float(np.ptp(while_coupled) / 2) if while_coupled.size else None,
         "distance_error": _error_stats(error),
@@ -115,7 +154,8 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
     pair and every recorded sample while coupled; ``direction_error_deg``: the
     largest angle between a pair's direction ``P_j - P_i`` and the direction it
     must hold (pairs that hold one); ``formed_at``: when the last pair coupled,
-    if all did; ``coupled_at_end``: the share of pairs coupled at the end.
+    if all did (0 if they started coupled); ``coupled_at_end``: the share of
+    pairs coupled at the end.
 
     Parameters
     ----------
@@ -137,7 +177,7 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
         "pairs": len(trajectory.pairs),
         "distance_error": _error_stats(error),
         "formed_at": formed_at,
-        "coupled_at_end": float(flag[-1].mean()) if len(flag) else None,
+        "coupled_at_end": float(coupling_states(trajectory)[2].mean()),
         "amplitude_max": None,
     }
     amplitudes = [
@@ -191,14 +231,77 @@ def summarize_events(events: list[Event]) -> list[dict]:
     return rows
 
 
+def _flying_rms(velocity: np.ndarray, active: np.ndarray) -> float | None:
+    """RMS velocity of the flying agents, ``None`` when none flies (an RMS over no agent is undefined)."""
+    return float(rms_velocity(velocity, active)) if np.any(active) else None
+
+
+def rms_summary(trajectory: Trajectory, pairs_coupled_at_end: int) -> dict:
+    """The RMS velocity at the start and the end, its change in %, and whether that change swings.
+
+    ``rms_change_percent`` is ``100 (rms_final / rms_initial - 1)``, each an
+    instantaneous value over the agents flying then (the measure of the
+    paper's Figs. 7 and 9).  While pairs are still coupled at the end, their
+    undamped oscillation trades speed for tilt and back, so this value swings
+    with the phase at which the run stops: ``rms_change_while_coupled`` is then
+    true.  ``None`` (JSON ``null``) where a value is undefined: no agent flying
+    at that time, or an initial RMS of 0.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    pairs_coupled_at_end : int
+        How many pairs are coupled at the end (:func:`coupling_states`).
+    """
+    model = trajectory.model
+    initial = _flying_rms(model.velocity(trajectory.initial.state), trajectory.initial.active)
+    final = _flying_rms(model.velocity(trajectory.final_state), trajectory.final_active)
+    defined = initial is not None and final is not None and initial > 0
+    return {
+        "rms_velocity_initial": initial,
+        "rms_velocity_final": final,
+        "rms_change_percent": 100.0 * (final / initial - 1.0) if defined else None,
+        "rms_change_while_coupled": pairs_coupled_at_end > 0,
+    }
+
+
+def coupling_summary(trajectory: Trajectory) -> dict:
+    """Whether and when pairs were coupled, as written to ``summary.json``.
+
+    ``coupled``: some pair was coupled at some time, from the start (a
+    formation's pairs start coupled, with no ``couple`` event) or after
+    coupling; ``pairs_coupled_at_start`` / ``_ever`` / ``_at_end``: how many
+    pairs were so; ``couple_time``: when a pair was first coupled (0 if one
+    started coupled); ``uncouple_time``: the first ``uncouple`` event (after an
+    operator's command, or a pair losing an agent).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    """
+    start, ever, end = coupling_states(trajectory)
+    events = trajectory.events
+    return {
+        "coupled": bool(ever.any()),
+        "pairs_coupled_at_start": int(start.sum()),
+        "pairs_coupled_ever": int(ever.sum()),
+        "pairs_coupled_at_end": int(end.sum()),
+        "couple_time": 0.0 if start.any() else _first([e.time for e in events if e.kind == "couple"]),
+        "uncouple_time": _first([e.time for e in events if e.kind == "uncouple"]),
+    }
+
+
 def summarize(trajectory: Trajectory) -> dict:
     """The run's summary, as written to ``summary.json``.
 
-    ``min_distance`` is the smallest distance two agents reached at any step
-    (formation pairs always; other pairs once within ``R + R_j``);
-    ``final_distance`` the smallest distance between two flying agents at the
-    end; ``coupled`` whether any pair coupled; ``couple_time`` /
-    ``uncouple_time`` the first such event of any pair.
+    The RMS velocity and its change: :func:`rms_summary`; coupling:
+    :func:`coupling_summary`.  ``min_distance`` is the smallest distance two
+    agents reached at any step (formation pairs always; other pairs once within
+    ``R + R_j``); ``final_distance`` the smallest distance between two flying
+    agents at the end.  Every number is finite: ``None`` (JSON ``null``) stands
+    for a value that does not exist (no agent flying, no two agents close).
 
     Parameters
     ----------
@@ -207,13 +310,9 @@ def summarize(trajectory: Trajectory) -> dict:
     """
     scenario = trajectory.scenario
     model = trajectory.model
-    rms = [
-        rms_velocity(model.velocity(trajectory.initial.state), trajectory.initial.active),
-        rms_velocity(model.velocity(trajectory.final_state), trajectory.final_active),
-    ]
-    box = trajectory.initial.box
+    coupling = coupling_summary(trajectory)
     min_pairs = float(trajectory.min_distance.min()) if len(trajectory.min_distance) else np.inf
-    min_distance = min(min_pairs, trajectory.min_neighbor_distance)
+    final_position = model.position(trajectory.final_state)
     return {
         "scenario": scenario.name,
         "function": scenario.interaction.function,
@@ -221,14 +320,10 @@ def summarize(trajectory: Trajectory) -> dict:
         "axes": scenario.space.axes,
         "dt": scenario.simulation.dt,
         "duration": scenario.simulation.duration,
-        "rms_velocity_initial": float(rms[0]),
-        "rms_velocity_final": float(rms[1]),
-        "rms_change_percent": float(100.0 * (rms[1] / rms[0] - 1.0)) if rms[0] > 0 else None,
-        "min_distance": float(min_distance) if np.isfinite(min_distance) else None,
-        "final_distance": nearest_distance(model.position(trajectory.final_state), trajectory.final_active, box),
-        "coupled": any(e.kind == "couple" for e in trajectory.events),
-        "couple_time": _first([e.time for e in trajectory.events if e.kind == "couple"]),
-        "uncouple_time": _first([e.time for e in trajectory.events if e.kind == "uncouple"]),
+        **rms_summary(trajectory, coupling["pairs_coupled_at_end"]),
+        "min_distance": _finite(min(min_pairs, trajectory.min_neighbor_distance)),
+        "final_distance": nearest_distance(final_position, trajectory.final_active, trajectory.initial.box),
+        **coupling,
         "final_velocities": model.velocity(trajectory.final_state).tolist() if trajectory.final_state.shape[0] <= 100 else None,
         "events": summarize_events(trajectory.events),
         "gains": trajectory.gains.tolist(),

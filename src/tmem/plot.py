@@ -9,6 +9,7 @@ formation's pairs against time.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -20,12 +21,15 @@ import numpy as np  # noqa: E402
 from . import metrics  # noqa: E402
 from .engine import Trajectory  # noqa: E402
 
+#: Matplotlib's warning for a character its font lacks (a name in CJK, an emoji).
+MISSING_GLYPH = r"Glyph \d+ .* missing from font"
 #: Most agents or pairs drawn one by one in a figure.
 MAX_DRAWN = 8
 _EVENT_STYLE = {"couple": ("tab:green", "-"), "uncouple": ("tab:red", "-"), "command": ("0.4", ":")}
 
 
 def _title(trajectory: Trajectory) -> str:
+    """The figure title; set it with ``parse_math=False``: a ``$`` in the scenario's name is a dollar, not mathtext."""
     s = trajectory.scenario
     name = f"{s.name}: " if s.name else ""
     return f"{name}{s.interaction.function} function, c_max = {s.interaction.c_max:g} rad"
@@ -62,7 +66,7 @@ def velocity_figure(trajectory: Trajectory):
     _mark_events(ax, trajectory)
     ax.set_xlabel("time, s")
     ax.set_ylabel("velocity, m/s" if one_axis else "speed, m/s")
-    ax.set_title(_title(trajectory))
+    ax.set_title(_title(trajectory), parse_math=False)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     return fig
@@ -90,7 +94,7 @@ def distance_figure(trajectory: Trajectory):
         top.axhline(d_t, color="tab:olive", linestyle="--", linewidth=1, label=f"d_t = {d_t:g} m")
     _mark_events(top, trajectory)
     top.set_ylabel("distance, m")
-    top.set_title(_title(trajectory))
+    top.set_title(_title(trajectory), parse_math=False)
     top.grid(alpha=0.3)
     top.legend(loc="best", fontsize=8)
     bottom.set_ylabel("F_en")
@@ -121,7 +125,7 @@ def formation_figure(trajectory: Trajectory):
     _mark_events(ax, trajectory)
     ax.set_xlabel("time, s")
     ax.set_ylabel("| distance - d_t |, m (coupled pairs)")
-    ax.set_title(f"formation of {len(trajectory.pairs)} pairs; " + _title(trajectory))
+    ax.set_title(f"formation of {len(trajectory.pairs)} pairs; " + _title(trajectory), parse_math=False)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     return fig
@@ -157,7 +161,9 @@ def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
     for name, make in makers:
         fig = make(trajectory)
         path = Path(directory) / name
-        fig.savefig(path, dpi=120)
+        with warnings.catch_warnings():  # a name in a script the font lacks is drawn as boxes, without a warning per glyph
+            warnings.filterwarnings("ignore", message=MISSING_GLYPH, category=UserWarning)
+            fig.savefig(path, dpi=120)
         plt.close(fig)
         paths.append(path)
     return paths

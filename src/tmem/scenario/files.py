@@ -24,6 +24,9 @@ from .tables import MODEL_KINDS, FieldError, ScenarioError
 #: Largest scenario or sweep file read (bytes): a bigger one is a mistake, not a scenario.
 MAX_FILE_BYTES = 16 * 2**20
 
+#: Top-level keys of a sweep file that no scenario has: a file with one is a sweep file (``docs/sweeps.md``).
+SWEEP_KEYS = ("base", "grid", "random", "case")
+
 #: The shipped scenarios, ``src/tmem/presets/NAME.toml``.
 PRESETS = ("fig5", "fig7", "fig9", "repulsion")
 
@@ -177,8 +180,15 @@ def loads(text: str, source: str = "<scenario>") -> Scenario:
         The scenario, in TOML.
     source : str
         Where the text came from, at the start of an error message.
+
+    Text with the keys of a sweep file (:data:`SWEEP_KEYS`) is refused in one line that says so.
     """
     data = parse_toml(text, source, ScenarioError)
+    sweep_keys = [key for key in SWEEP_KEYS if key in data]
+    if sweep_keys:
+        raise ScenarioError(
+            f"{source}: is a sweep file (it has {', '.join(sweep_keys)}), not a scenario; run it with tmem sweep"
+        )
     try:
         return from_dict(data)
     except ScenarioError as exc:

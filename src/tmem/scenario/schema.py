@@ -35,6 +35,7 @@ from .tables import (
     SpaceParams,
     StrictModel,
     SwarmParams,
+    per_axis,
 )
 
 #: Most bytes a run may set aside for its records.
@@ -156,7 +157,7 @@ class Scenario(StrictModel):
             if region is None:
                 raise FieldError("swarm.region", "is required unless space.box is given")
             if len(region) != axes:
-                raise FieldError("swarm.region", f"needs {axes} values (one per axis), got {len(region)}")
+                raise FieldError("swarm.region", per_axis(axes, len(region)))
         if self.simulation.record_agents is not None:
             for k, a in enumerate(self.simulation.record_agents):
                 if not 0 <= a < n:
@@ -261,7 +262,7 @@ class Scenario(StrictModel):
             for name in ("position", "velocity", "tilt", "tilt_rate"):
                 value = getattr(agent, name)
                 if isinstance(value, list) and len(value) != axes:
-                    raise FieldError(f"agents[{k}].{name}", f"needs {axes} values (one per axis), got {len(value)}")
+                    raise FieldError(f"agents[{k}].{name}", per_axis(axes, len(value)))
                 if not isinstance(value, list) and axes > 1 and (name == "position" or value != 0.0):
                     raise FieldError(f"agents[{k}].{name}", f"needs a list of {axes} values for axes = {axes}")
 
@@ -279,7 +280,7 @@ class Scenario(StrictModel):
         for name in ("center", "velocity"):
             value = getattr(f, name)
             if value is not None and len(value) != axes:
-                raise FieldError(f"formation.{name}", f"needs {axes} values (one per axis), got {len(value)}")
+                raise FieldError(f"formation.{name}", per_axis(axes, len(value)))
         if f.kind == "edges":
             seen = set()
             for k, edge in enumerate(f.edges):

@@ -38,6 +38,22 @@ class FieldError(ValueError):
         self.reason = reason
 
 
+def per_axis(axes: int, got: int) -> str:
+    """Why a list of ``got`` values is refused where one value per axis is needed, and the fix.
+
+    Parameters
+    ----------
+    axes : int
+        ``space.axes``.
+    got : int
+        How many values were given.
+    """
+    reason = f"needs {axes} value{'s' if axes > 1 else ''}, one per axis (space.axes = {axes}), got {got}"
+    if 1 <= got <= 3:
+        reason += f"; for a {got}-D run set axes = {got} in [space]"
+    return reason
+
+
 class StrictModel(BaseModel):
     """Base of the scenario tables: unknown keys, non-finite numbers and quiet coercions refused."""
 
@@ -171,7 +187,7 @@ class SpaceParams(StrictModel):
     @model_validator(mode="after")
     def _box_fits(self) -> "SpaceParams":
         if self.box is not None and len(self.box) != self.axes:
-            raise FieldError("box", f"needs {self.axes} values (one per axis), got {len(self.box)}")
+            raise FieldError("box", per_axis(self.axes, len(self.box)))
         if self.periodic and self.box is None:
             raise FieldError("box", "is required when periodic = true")
         return self
