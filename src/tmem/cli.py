@@ -202,6 +202,7 @@ def sweep_command(
             outcome = run_sweep(
                 sweep, out, scheduler=scheduler, workers=workers,
                 progress=lambda done, total: bar.update(task, completed=done),
+                notify=lambda line: console.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True),
             )  # fmt: skip
     except (SweepError, OutputError) as exc:
         _fail(str(exc))

@@ -160,6 +160,7 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> SweepOutcome:
     """Run every case of ``sweep`` not yet done in ``out``; write the table, ``summary.md`` and figures.
 
@@ -176,12 +177,15 @@ def run_sweep(
         Worker processes of the local cluster; ``None``: one per core.
     progress
         Called as ``progress(cases_done, cases_total)`` as tasks finish.
+    notify
+        Called as ``notify(line)`` when a file of rows that cannot be read is
+        set aside and its cases run again; by default a :class:`UserWarning`.
 
     Raises :class:`SweepInterrupted` on Ctrl-C, after saving what finished.
     """
     started = time.perf_counter()
     out = Path(out)
-    store = ResultStore.check(out, sweep)
+    store = ResultStore.check(out, sweep, notify)
     metrics = store.metrics
     with ExitStack() as held:
         if store.exists:

@@ -1,0 +1,138 @@
+"""A sweep meets what is not its own: a damaged file of rows, a --scheduler that is no Dask scheduler, bad options."""
+
+import socket
+import socketserver
+import threading
+import time
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+from dask.distributed import LocalCluster
+from typer.testing import CliRunner
+
+from tmem.cli import app
+from tmem.sweep import loads_sweep, run_sweep
+from tmem.sweep.store import ResultStore
+from tmem.sweep.tasks import run_chunk
+
+SWEEP = """
+name = "small"
+base = "fig7"
+cases = 6
+seed = 5
+[set]
+"simulation.dt" = 0.01
+"simulation.duration" = 40.0
+[random]
+"agents.0.position" = { uniform = [45, 70] }
+"""
+
+
+@pytest.fixture(scope="module")
+def threads():
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster:
+        yield cluster.scheduler_address
+
+
+@pytest.fixture
+def sweep_file(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(SWEEP)
+    return path
+
+
+def invoke(*args):
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    return result.exit_code, result.stderr
+
+
+def one_line_refusal(code, stderr):
+    assert code == 2, stderr
+    assert stderr.count("\n") == 1 and stderr.startswith("error: "), stderr
+    assert "Traceback" not in stderr
+
+
+# --- A damaged file of rows is set aside, its cases run again
+
+
+def two_parts(out: Path, sweep) -> list[Path]:
+    """Write the sweep's first 4 cases as two parts (2 cases each), as an interrupted sweep leaves them."""
+    metrics = tuple(sweep.spec.metrics)
+    cases = sweep.cases()
+    store = ResultStore.check(out, sweep)
+    with store.opened():
+        store.add(run_chunk(sweep.base, cases[0:2], metrics))
+        store.add(run_chunk(sweep.base, cases[2:4], metrics))
+    parts = sorted((out / "parts").glob("part-*.parquet"))
+    assert len(parts) == 2
+    return parts
+
+
+def truncate(path: Path) -> None:
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+
+
+def flip_a_bit_in_the_data(path: Path) -> None:
+    """Flip one bit of the ``case`` column's last data byte: only the page checksum tells."""
+    column = pq.ParquetFile(path).metadata.row_group(0).column(0)
+    assert column.path_in_schema == "case"
+    start = column.dictionary_page_offset or column.data_page_offset
+    data = bytearray(path.read_bytes())
+    data[start + column.total_compressed_size - 1] ^= 0x01
+    path.write_bytes(bytes(data))
+
+
+def garbage(path: Path) -> None:
+    path.write_bytes(b"PAR1" + b"\x00garbage" * 100 + b"PAR1")
+
+
+def other_cases(path: Path) -> None:
+    """A readable part whose case numbers are not the sweep's (as if copied from a larger one)."""
+    frame = pd.read_parquet(path)
+    frame["case"] += 1000
+    frame.to_parquet(path, index=False)
+
+
+@pytest.mark.parametrize("damage", [truncate, flip_a_bit_in_the_data, garbage, other_cases])
+def test_a_damaged_part_is_set_aside_and_its_cases_run_again(threads, tmp_path, damage):
+    sweep = loads_sweep(SWEEP, source="small.toml")
+    out = tmp_path / "out"
+    damaged, whole = two_parts(out, sweep)
+    damage(damaged)
+    kept = damaged.read_bytes()
+    lines = []
+    outcome = run_sweep(sweep, out, scheduler=threads, notify=lines.append)
+    assert list(outcome.table["case"]) == list(range(6))
+    assert outcome.ran == 4  # the 2 cases of the damaged part and the 2 never run
+    assert outcome.table["error"].isna().all()
+    aside = out / (damaged.name + ".corrupt")
+    assert aside.read_bytes() == kept  # set aside as it was, never deleted
+    assert len(lines) == 1 and "\n" not in lines[0]
+    assert f"parts/{damaged.name}" in lines[0] and f"set aside as {aside.name}" in lines[0]
+    assert not (out / "parts").exists()
+    # The next run finds everything done, and leaves the set-aside file alone.
+    again = run_sweep(sweep, out, scheduler=threads, notify=lines.append)
+    assert again.ran == 0 and len(lines) == 1 and aside.read_bytes() == kept
+
+
+def test_a_damaged_results_file_is_set_aside_and_the_sweep_runs_again(threads, tmp_path, sweep_file):
+    out = tmp_path / "out"
+    code, stderr = invoke("sweep", sweep_file, "--out", out, "--scheduler", threads)
+    assert code == 0, stderr
+    truncate(out / "results.parquet")
+    kept = (out / "results.parquet").read_bytes()
+    code, stderr = invoke("sweep", sweep_file, "--out", out, "--scheduler", threads)
+    assert code == 0, stderr
+    assert stderr.count("\n") == 1 and stderr.startswith("warning: results.parquet in ") and "Traceback" not in stderr
+    assert "set aside as results.parquet.corrupt, its cases run again" in stderr
+    assert (out / "results.parquet.corrupt").read_bytes() == kept
+    assert list(pd.read_parquet(out / "results.parquet")["case"]) == list(range(6))
+    # Damaged again: the earlier set-aside file is kept, the new one takes the next free name.
+    truncate(out / "results.parquet")
+    code, stderr = invoke("sweep", sweep_file, "--out", out, "--scheduler", threads)
+    assert code == 0, stderr
+    assert (out / "results.parquet.corrupt").read_bytes() == kept and (out / "results.parquet.2.corrupt").exists()
+
