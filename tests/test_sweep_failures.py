@@ -32,9 +32,14 @@ seed = 5
 
 
 @pytest.fixture(scope="module")
-def threads():
+def cluster():
     with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster:
-        yield cluster.scheduler_address
+        yield cluster
+
+
+@pytest.fixture(scope="module")
+def threads(cluster):
+    return cluster.scheduler_address
 
 
 @pytest.fixture
@@ -136,3 +141,89 @@ def test_a_damaged_results_file_is_set_aside_and_the_sweep_runs_again(threads, t
     assert code == 0, stderr
     assert (out / "results.parquet.corrupt").read_bytes() == kept and (out / "results.parquet.2.corrupt").exists()
 
+
+
+# --- A --scheduler that is not a Dask scheduler is refused, in a bounded time, leaving nothing
+
+
+class Garbage(socketserver.BaseRequestHandler):
+    """Answers every connection with bytes that are not Dask's protocol, until it is closed."""
+
+    def handle(self):
+        try:
+            for _ in range(1200):
+                self.request.sendall(b"\xff\xfe not a dask scheduler \x00" * 64)
+                time.sleep(0.05)
+        except OSError:
+            pass
+
+
+class QuietWeb(SimpleHTTPRequestHandler):
+    """A web server's answers, without its log lines on standard error."""
+
+    def log_message(self, *args):
+        pass
+
+
+def serving(server) -> str:
+    server.daemon_threads = True
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    host, port = server.server_address[:2]
+    return f"tcp://{host}:{port}"
+
+
+@pytest.fixture
+def web_server():
+    with ThreadingHTTPServer(("127.0.0.1", 0), QuietWeb) as server:
+        yield serving(server)
+        server.shutdown()
+
+
+@pytest.fixture
+def garbage_server():
+    with socketserver.ThreadingTCPServer(("127.0.0.1", 0), Garbage) as server:
+        yield serving(server)
+        server.shutdown()
+
+
+def closed_port() -> str:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return f"tcp://127.0.0.1:{s.getsockname()[1]}"
+
+
+def sweep_at(address, tmp_path, sweep_file):
+    """``tmem sweep --scheduler address``; fails the test if it has not ended after a minute (a hang)."""
+    ended = {}
+
+    def sweep():
+        ended["code"], ended["stderr"] = invoke("sweep", sweep_file, "--out", tmp_path / "new" / "out", "--scheduler", address)
+
+    thread = threading.Thread(target=sweep, daemon=True)
+    thread.start()
+    thread.join(60)
+    assert not thread.is_alive(), f"tmem sweep --scheduler {address} hangs"
+    return ended["code"], ended["stderr"]
+
+
+@pytest.mark.parametrize(
+    "server, why",
+    [
+        ("web_server", "nothing answered as a Dask scheduler within 2 s"),
+        ("garbage_server", "what answers there is not a Dask scheduler"),
+        ("worker", "what answers there is a Dask Worker, not a scheduler"),
+        ("closed_port", "cannot connect (OSError: Timed out trying to connect to"),
+    ],
+)
+def test_a_scheduler_that_is_not_one_is_refused_in_one_line(request, cluster, tmp_path, sweep_file, monkeypatch, server, why):
+    monkeypatch.setattr("tmem.sweep.runner.CONNECT_SECONDS", 2.0)  # the command's bound is 10 s; 2 s here
+    if server == "worker":
+        address = next(iter(cluster.scheduler_info["workers"]))
+    elif server == "closed_port":
+        address = closed_port()
+    else:
+        address = request.getfixturevalue(server)
+    code, stderr = sweep_at(address, tmp_path, sweep_file)
+    one_line_refusal(code, stderr)
+    assert stderr.startswith(f"error: --scheduler {address}: {why}"), stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml"]  # no skeleton of a sweep folder

@@ -43,6 +43,8 @@ FLUSH_SECONDS = 2.0
 FLUSH_ROWS = 2000
 #: How often (s) the collecting loop looks for finished tasks and for Ctrl-C.
 POLL_SECONDS = 0.05
+#: A ``--scheduler`` must answer as a Dask scheduler within this time (s), or the sweep is refused.
+CONNECT_SECONDS = 10.0
 
 
 class SweepInterrupted(Exception):
@@ -81,6 +83,63 @@ def _takes_signals() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+async def _identity(address: str, seconds: float) -> dict:
+    """What the Dask server at ``address`` says it is (its ``identity``), over one short connection."""
+    from distributed.comm import connect
+    from distributed.security import Security
+
+    # distributed's connect retries until its timeout, but then waits for the other end's
+    # handshake without one: the caller bounds the whole.
+    comm = await connect(address, timeout=0.9 * seconds, **Security().get_connection_args("client"))
+    try:
+        await comm.write({"op": "identity", "reply": True})  # any Dask server answers it, with its type
+        return await comm.read()
+    finally:
+        comm.abort()
+
+
+def check_scheduler(address: str, seconds: float | None = None) -> None:
+    """Refuse, within about ``seconds``, an ``address`` where no Dask scheduler answers.
+
+    A service that is not Dask's (a web server, one that sends garbage)
+    would leave :class:`dask.distributed.Client` waiting forever, or
+    allocating what the garbage asks for; this asks once, bounded.
+
+    Parameters
+    ----------
+    address : str
+        The ``--scheduler`` address, such as ``tcp://host:8786``.
+    seconds : float, optional
+        The longest wait for the answer (s); by default :data:`CONNECT_SECONDS`.
+
+    Raises
+    ------
+    SweepError
+        In one line naming ``--scheduler`` and the reason.
+    """
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    seconds = CONNECT_SECONDS if seconds is None else seconds
+    try:
+        with ThreadPoolExecutor(1) as thread:  # a loop of its own, even where one runs (a notebook)
+            identity = thread.submit(asyncio.run, asyncio.wait_for(_identity(address, seconds), seconds)).result()
+    except TimeoutError:
+        why = f"nothing answered as a Dask scheduler within {seconds:g} s"
+    except (OSError, ValueError) as exc:  # unreachable, refused, closed, or a malformed address
+        why = f"cannot connect ({one_line(exc)})"
+    except Exception:  # e.g. a length prefix of 3 EiB: what answered does not speak Dask's protocol
+        why = "what answers there is not a Dask scheduler"
+    else:
+        kind = identity.get("type") if isinstance(identity, dict) else None
+        if kind == "Scheduler":
+            return
+        why = "what answers there is not a Dask scheduler"
+        if isinstance(kind, str):
+            why = f"what answers there is a Dask {kind}, not a scheduler"
+    raise SweepError(f"--scheduler {address}: {why}")
+
+
 @contextmanager
 def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
     """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes.
@@ -95,6 +154,7 @@ def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
+        check_scheduler(scheduler)
         try:
             client = Client(scheduler, timeout="20s", set_as_default=False)  # a failed one must not linger as the default
         except (OSError, TimeoutError, ValueError) as exc:
