@@ -216,7 +216,7 @@ def sweep_at(address, tmp_path, sweep_file):
     ],
 )
 def test_a_scheduler_that_is_not_one_is_refused_in_one_line(request, cluster, tmp_path, sweep_file, monkeypatch, server, why):
-    monkeypatch.setattr("tmem.sweep.runner.CONNECT_SECONDS", 2.0)  # the command's bound is 10 s; 2 s here
+    monkeypatch.setattr("tmem.sweep.cluster.CONNECT_SECONDS", 2.0)  # the command's bound is 10 s; 2 s here
     if server == "worker":
         address = next(iter(cluster.scheduler_info["workers"]))
     elif server == "closed_port":

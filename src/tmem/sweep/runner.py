@@ -4,8 +4,9 @@
 leaves out the cases already done, groups the others into chunks
 (:func:`tmem.sweep.tasks.plan_chunks`), submits one task per chunk and
 writes rows as tasks finish.  The local cluster and a remote one take the
-same path: a :class:`dask.distributed.Client` and its futures.  A remote
-cluster's workers need tmem installed, in the same version.
+same path: a :class:`dask.distributed.Client` and its futures
+(:mod:`tmem.sweep.cluster`).  A remote cluster's workers need tmem
+installed, in the same version.
 
 Nothing is lost when a sweep stops early: on Ctrl-C the rows received are
 written before :class:`SweepInterrupted` is raised (SIGTERM and SIGHUP alike); a killed worker's tasks
@@ -19,9 +20,7 @@ case that raises.
 
 from __future__ import annotations
 
-import logging
 import math
-import os
 import signal
 import threading
 import time
@@ -33,8 +32,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from .cluster import check_workers, dask_client, takes_signals
 from .report import write_report
-from .spec import Sweep, SweepError
+from .spec import Sweep
 from .store import ResultStore
 from .tasks import one_line, plan_chunks, row, run_chunk
 
@@ -43,8 +43,6 @@ FLUSH_SECONDS = 2.0
 FLUSH_ROWS = 2000
 #: How often (s) the collecting loop looks for finished tasks and for Ctrl-C.
 POLL_SECONDS = 0.05
-#: A ``--scheduler`` must answer as a Dask scheduler within this time (s), or the sweep is refused.
-CONNECT_SECONDS = 10.0
 
 
 class SweepInterrupted(Exception):
@@ -78,117 +76,6 @@ class SweepOutcome:
     seconds: float
 
 
-def _takes_signals() -> bool:
-    """Only the main thread can install signal handlers."""
-    return threading.current_thread() is threading.main_thread()
-
-
-async def _identity(address: str, seconds: float) -> dict:
-    """What the Dask server at ``address`` says it is (its ``identity``), over one short connection."""
-    from distributed.comm import connect
-    from distributed.security import Security
-
-    # distributed's connect retries until its timeout, but then waits for the other end's
-    # handshake without one: the caller bounds the whole.
-    comm = await connect(address, timeout=0.9 * seconds, **Security().get_connection_args("client"))
-    try:
-        await comm.write({"op": "identity", "reply": True})  # any Dask server answers it, with its type
-        return await comm.read()
-    finally:
-        comm.abort()
-
-
-def check_scheduler(address: str, seconds: float | None = None) -> None:
-    """Refuse, within about ``seconds``, an ``address`` where no Dask scheduler answers.
-
-    A service that is not Dask's (a web server, one that sends garbage)
-    would leave :class:`dask.distributed.Client` waiting forever, or
-    allocating what the garbage asks for; this asks once, bounded.
-
-    Parameters
-    ----------
-    address : str
-        The ``--scheduler`` address, such as ``tcp://host:8786``.
-    seconds : float, optional
-        The longest wait for the answer (s); by default :data:`CONNECT_SECONDS`.
-
-    Raises
-    ------
-    SweepError
-        In one line naming ``--scheduler`` and the reason.
-    """
-    import asyncio
-    from concurrent.futures import ThreadPoolExecutor
-
-    seconds = CONNECT_SECONDS if seconds is None else seconds
-    try:
-        with ThreadPoolExecutor(1) as thread:  # a loop of its own, even where one runs (a notebook)
-            identity = thread.submit(asyncio.run, asyncio.wait_for(_identity(address, seconds), seconds)).result()
-    except TimeoutError:
-        why = f"nothing answered as a Dask scheduler within {seconds:g} s"
-    except (OSError, ValueError) as exc:  # unreachable, refused, closed, or a malformed address
-        why = f"cannot connect ({one_line(exc)})"
-    except Exception:  # e.g. a length prefix of 3 EiB: what answered does not speak Dask's protocol
-        why = "what answers there is not a Dask scheduler"
-    else:
-        kind = identity.get("type") if isinstance(identity, dict) else None
-        if kind == "Scheduler":
-            return
-        why = "what answers there is not a Dask scheduler"
-        if isinstance(kind, str):
-            why = f"what answers there is a Dask {kind}, not a scheduler"
-    raise SweepError(f"--scheduler {address}: {why}")
-
-
-@contextmanager
-def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
-    """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes.
-
-    Parameters
-    ----------
-    scheduler : str or None
-        Address of an existing Dask scheduler; ``None`` starts a local cluster.
-    workers : int or None
-        Worker processes of the local cluster; ``None``: one per core.
-    """
-    from dask.distributed import Client, LocalCluster
-
-    if scheduler:
-        check_scheduler(scheduler)
-        try:
-            client = Client(scheduler, timeout="20s", set_as_default=False)  # a failed one must not linger as the default
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise SweepError(f"--scheduler {scheduler}: cannot connect ({one_line(exc)})") from None
-        try:
-            yield client
-        finally:
-            client.close()
-        return
-    # Ctrl-C reaches every process of the terminal's group.  The worker processes are started with
-    # SIGINT ignored (they inherit it), so that only this process answers it: it saves the rows it
-    # has and shuts the cluster down, instead of every worker dying with a traceback.
-    main_thread = _takes_signals()
-    interrupt = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
-    try:
-        cluster = LocalCluster(
-            n_workers=workers or os.cpu_count() or 1,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",
-            silence_logs=logging.ERROR,
-            env={"NUMBA_NUM_THREADS": "1"},  # one process per core; no threads within
-        )  # fmt: skip
-    finally:
-        if main_thread:
-            signal.signal(signal.SIGINT, interrupt)
-    client = Client(cluster, set_as_default=False)
-    try:
-        yield client
-    finally:
-        client.close()
-        cluster.close()
-
-
 @contextmanager
 def _ctrl_c_as_flag() -> Iterator[threading.Event]:
     """While the sweep runs, Ctrl-C (and SIGTERM, SIGHUP) set a flag that the collecting loop reads between tasks.
@@ -199,7 +86,7 @@ def _ctrl_c_as_flag() -> Iterator[threading.Event]:
     flag is never set.  A signal set to be ignored stays ignored.)
     """
     flag = threading.Event()
-    if not _takes_signals():
+    if not takes_signals():
         yield flag
         return
     previous = {}
@@ -245,6 +132,7 @@ def run_sweep(
     """
     started = time.perf_counter()
     out = Path(out)
+    workers = check_workers(workers, scheduler)
     store = ResultStore.check(out, sweep, notify)
     metrics = store.metrics
     with ExitStack() as held:
