@@ -1,5 +1,7 @@
 """A sweep meets what is not its own: a damaged file of rows, a --scheduler that is no Dask scheduler, bad options."""
 
+import io
+import logging
 import socket
 import socketserver
 import threading
@@ -14,7 +16,8 @@ from dask.distributed import LocalCluster
 from typer.testing import CliRunner
 
 from tmem.cli import app
-from tmem.sweep import loads_sweep, run_sweep
+from tmem.sweep import SweepError, loads_sweep, run_sweep
+from tmem.sweep.cluster import DaskLog, check_workers, dask_client
 from tmem.sweep.store import ResultStore
 from tmem.sweep.tasks import run_chunk
 
@@ -227,3 +230,80 @@ def test_a_scheduler_that_is_not_one_is_refused_in_one_line(request, cluster, tm
     one_line_refusal(code, stderr)
     assert stderr.startswith(f"error: --scheduler {address}: {why}"), stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml"]  # no skeleton of a sweep folder
+
+
+# --- Dask's log while a sweep runs: errors that are news, one line each; nothing of its recovery
+
+
+@pytest.fixture
+def dask_says():
+    """Dask's log handled as in a command (distributed's set-up: one handler, on these loggers), into a string."""
+    said = io.StringIO()
+    handler = logging.StreamHandler(said)
+    loggers = [logging.getLogger(name) for name in ("distributed", "distributed.client")]
+    propagate = [logger.propagate for logger in loggers]
+    for logger in loggers:
+        logger.addHandler(handler)
+        logger.propagate = False
+    yield said
+    for logger, before in zip(loggers, propagate):
+        logger.removeHandler(handler)
+        logger.propagate = before
+
+
+def test_dask_errors_are_one_line_and_its_recovery_is_not_shown(threads, dask_says):
+    with dask_client(threads, None):
+        try:
+            raise ConnectionError("the scheduler\nwent away")
+        except ConnectionError:
+            logging.getLogger("distributed.client").error("Failed to reconnect:\n  giving up", exc_info=True)
+        logging.getLogger("distributed.scheduler").error("Couldn't gather keys: {'run_chunk-1': 'queued'}")
+        logging.getLogger("distributed.scheduler").warning("Removing worker; rescheduling its tasks")
+    said = dask_says.getvalue()
+    assert said.count("\n") == 1 and "Traceback" not in said, said
+    assert said == "Failed to reconnect: giving up\n", said
+    handlers = logging.getLogger("distributed").handlers
+    assert not any(isinstance(f, DaskLog) for h in handlers for f in h.filters)  # held only while the client is
+
+
+def test_nothing_of_dask_is_shown_once_the_sweep_stops():
+    log = DaskLog()
+    record = logging.LogRecord("distributed.scheduler", logging.CRITICAL, "scheduler.py", 1, "Closed comm", (), None)
+    assert log.filter(record)
+    log.closing = True
+    assert not log.filter(record)
+
+
+# --- --workers: one line naming it
+
+
+@pytest.mark.parametrize(
+    "workers, why",
+    [
+        ("0", "must be at least 1"),
+        ("-2", "must be at least 1"),
+        ("two", "must be a whole number of worker processes"),
+        ("1.5", "must be a whole number of worker processes"),
+        ("100000", "more than 8 per core"),
+    ],
+)
+def test_a_bad_workers_count_is_refused_in_one_line(tmp_path, sweep_file, workers, why):
+    code, stderr = invoke("sweep", sweep_file, "--out", tmp_path / "out", "--workers", workers)
+    one_line_refusal(code, stderr)
+    assert stderr.startswith(f"error: --workers {workers}: {why}"), stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml"]
+
+
+def test_workers_with_a_scheduler_is_refused(threads, tmp_path, sweep_file):
+    code, stderr = invoke("sweep", sweep_file, "--out", tmp_path / "out", "--workers", "2", "--scheduler", threads)
+    one_line_refusal(code, stderr)
+    assert "--workers 2: is for the local cluster; with --scheduler" in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml"]
+
+
+def test_the_python_api_checks_workers_alike(tmp_path):
+    sweep = loads_sweep(SWEEP, source="small.toml")
+    with pytest.raises(SweepError, match="--workers 0: must be at least 1"):
+        run_sweep(sweep, tmp_path / "out", workers=0)
+    assert not (tmp_path / "out").exists()
+    assert check_workers(None) is None and check_workers(3) == 3 and check_workers(" 2 ") == 2

@@ -144,7 +144,13 @@ class DaskLog(logging.Filter):
         self.closing = False
 
     def filter(self, record: logging.LogRecord) -> bool:
-        """Whether to show ``record``; one shown loses its traceback and has its whitespace folded."""
+        """Whether to show ``record``; one shown loses its traceback and has its whitespace folded.
+
+        Parameters
+        ----------
+        record : logging.LogRecord
+            A record of Dask's log, on its way to a handler.
+        """
         message = record.getMessage()
         if self.closing or record.levelno < logging.ERROR or message.startswith(RECOVERING):
             return False
@@ -153,12 +159,19 @@ class DaskLog(logging.Filter):
         return True
 
 
-@contextmanager
-def _dask_log() -> Iterator[DaskLog]:
-    """Hold a :class:`DaskLog` on the handlers of the ``distributed`` logger (which its import sets up)."""
+def _dask_handlers() -> list[logging.Handler]:
+    """The handlers of the ``distributed`` logger and those below it (its import sets them up)."""
     import distributed  # noqa: F401
 
-    handlers = list(logging.getLogger("distributed").handlers)
+    names = [name for name in logging.root.manager.loggerDict if name == "distributed" or name.startswith("distributed.")]
+    handlers = {id(h): h for name in names for h in logging.getLogger(name).handlers}
+    return list(handlers.values())
+
+
+@contextmanager
+def _dask_log() -> Iterator[DaskLog]:
+    """Hold a :class:`DaskLog` on the handlers of Dask's log."""
+    handlers = _dask_handlers()
     log = DaskLog()
     for handler in handlers:
         handler.addFilter(log)
@@ -172,7 +185,7 @@ def _dask_log() -> Iterator[DaskLog]:
 @contextmanager
 def _errors_shown(log: DaskLog) -> Iterator[None]:
     """Let errors through the handlers' levels while the client is used; then close ``log``."""
-    handlers = list(logging.getLogger("distributed").handlers)
+    handlers = _dask_handlers()
     levels = [handler.level for handler in handlers]
     for handler in handlers:
         handler.setLevel(logging.ERROR)  # the local cluster set them to CRITICAL for its worker processes' sake
