@@ -13,6 +13,7 @@ fixtures).
 
 import json
 import os
+import re
 import select
 import shutil
 import signal
@@ -22,6 +23,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
+import psutil
 import pytest
 from dask.distributed import Client, LocalCluster
 from typer.testing import CliRunner
@@ -75,11 +77,14 @@ def partials(folder: Path, name: str) -> list[str]:
 
 
 class Command:
-    """``python -m tmem ARGS`` in a session of its own, its output on a pseudo-terminal (progress bars show)."""
+    """``python -m tmem ARGS`` in a session of its own, its output on a pseudo-terminal (progress bars show).
 
-    def __init__(self, *args, cwd: Path):
+    With ``terminal=False`` its output goes to a pipe instead: no progress bar, only the lines it says.
+    """
+
+    def __init__(self, *args, cwd: Path, terminal: bool = True):
         env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "TERM": "xterm", "COLUMNS": "100"}
-        self.master, slave = os.openpty()
+        self.master, slave = os.openpty() if terminal else os.pipe()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "tmem", *map(str, args)],
             stdin=subprocess.DEVNULL, stdout=slave, stderr=slave, cwd=cwd, env=env, start_new_session=True,
@@ -302,3 +307,76 @@ def test_two_sweeps_into_one_directory_at_once(cluster, sweep_file, tmp_path):
     result = CliRunner().invoke(app, ["sweep", str(sweep_file), "--out", str(out), "--scheduler", cluster])
     assert result.exit_code == 0, result.output
     assert list(pd.read_parquet(out / "results.parquet")["case"]) == list(range(N_SWEEP_CASES))
+
+
+# --- tmem sweep on its own local cluster: Ctrl-C says one line, a killed worker nothing
+
+# 200 cases, 8 a task: half a minute or more on two workers.  (Tasks of a second or more make it
+# likelier that a killed worker held a result not yet gathered, which Dask then says it could not.)
+LOCAL_SWEEP = SWEEP.replace("cases = 20", "cases = 100").replace("batch = 1", "batch = 8")
+LOCAL_CASES = 200
+INTERRUPTED = re.compile(rf"interrupted: [0-9]+ of {LOCAL_CASES} cases saved; run the same command again to go on\n")
+
+
+def workers_of(command: Command) -> list[psutil.Process]:
+    """The worker processes of the command's local cluster (started by multiprocessing's spawn)."""
+    try:
+        children = psutil.Process(command.process.pid).children()
+        return [p for p in children if "spawn_main" in " ".join(p.cmdline())]
+    except psutil.Error:
+        return []
+
+
+def catches_sigint(pid: int) -> bool:
+    """Whether process ``pid`` has a handler for SIGINT (neither the default nor ignored)."""
+    status = Path(f"/proc/{pid}/status").read_text()
+    caught = int(next(line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:")), 16)
+    return bool(caught & (1 << (signal.SIGINT - 1)))
+
+
+#: Moments of a sweep on a local cluster: its workers exist and start up (no output folder yet),
+#: its tasks run (no rows yet), rows are saved.
+LOCAL_MOMENTS = {
+    "workers starting": lambda c, out: len(workers_of(c)) == 2 and catches_sigint(c.process.pid) and not out.exists(),
+    "tasks running": lambda c, out: (out / "parts").is_dir() and not saved_rows(out),
+    "saving rows": lambda c, out: saved_rows(out),
+}
+
+
+@pytest.fixture
+def local_sweep(tmp_path):
+    path = tmp_path / "encounters.toml"
+    path.write_text(LOCAL_SWEEP)
+    return path
+
+
+@pytest.mark.parametrize("reaching", ["the group", "the command alone"])
+@pytest.mark.parametrize("when", LOCAL_MOMENTS)
+def test_ctrl_c_on_a_local_sweep_says_one_line(local_sweep, tmp_path, when, reaching):
+    """Neither lost while the workers start, nor followed by Dask's tracebacks as the cluster shuts down."""
+    out = tmp_path / "out"
+    command = Command("sweep", local_sweep, "--out", out, "--workers", 2, cwd=tmp_path, terminal=False)
+    reached = command.wait_for(lambda: LOCAL_MOMENTS[when](command, out), timeout=120)
+    if reached:  # Ctrl-C reaches the terminal's whole group; kill -INT the command alone
+        (os.killpg if reaching == "the group" else os.kill)(command.process.pid, signal.SIGINT)
+    code, output = command.finish()
+    assert reached, f"the sweep ended before the moment {when!r}: {output}"
+    assert code == 130, output
+    assert INTERRUPTED.fullmatch(output), output
+    assert not (out / "results.parquet").exists() and (not out.exists() or sweep_leftovers(out) == [])
+
+
+def test_a_killed_worker_of_a_local_sweep_says_nothing(local_sweep, tmp_path):
+    """Dask runs the lost tasks again; its messages about recovering ("Couldn't gather keys") are not shown."""
+    out = tmp_path / "out"
+    command = Command("sweep", local_sweep, "--out", out, "--workers", 2, cwd=tmp_path, terminal=False)
+    try:
+        assert command.wait_for(lambda: saved_rows(out), timeout=120), command.output
+        workers_of(command)[0].kill()
+    finally:
+        code, output = command.finish(timeout=600)
+    assert code == 0, output
+    assert output.startswith(f"{LOCAL_CASES} cases ({LOCAL_CASES} run now, 0 failed) in "), output
+    for word in ("ERROR", "CRITICAL", "WARNING", "Traceback", "Couldn't gather"):
+        assert word not in output, output
+    assert list(pd.read_parquet(out / "results.parquet")["case"]) == list(range(LOCAL_CASES))

@@ -194,7 +194,7 @@ def sweep_command(
     sweep_file: Path = typer.Argument(..., help="Sweep TOML file (see examples/sweeps/ and docs/sweeps.md)."),
     out: Path = typer.Option(..., "--out", "-o", help="Output directory; run again to resume an interrupted sweep."),
     scheduler: str = typer.Option(None, help="Address of an existing Dask scheduler; default: a local cluster."),
-    workers: int = typer.Option(None, min=1, help="Worker processes of the local cluster; default: one per core."),
+    workers: str = typer.Option(None, metavar="N", help="Worker processes of the local cluster; default: one per core."),
 ) -> None:
     """Run every case of SWEEP_FILE on Dask; write results.parquet, summary.md and figures to OUT.
 
@@ -207,13 +207,15 @@ def sweep_command(
         Output directory; run again to resume an interrupted sweep.
     scheduler : str or None
         Address of an existing Dask scheduler; default: a local cluster.
-    workers : int or None
-        Worker processes of the local cluster; default: one per core.
+    workers : str or None
+        Worker processes of the local cluster (a whole number); default: one per core.
     """
     from .io import OutputError
     from .sweep import SweepError, SweepInterrupted, load_sweep, run_sweep
+    from .sweep.cluster import check_workers
 
     try:
+        count = check_workers(workers, scheduler)
         sweep = load_sweep(sweep_file)
     except SweepError as exc:
         _fail(str(exc))
@@ -225,8 +227,9 @@ def sweep_command(
     try:
         with bar:
             outcome = run_sweep(
-                sweep, out, scheduler=scheduler, workers=workers,
+                sweep, out, scheduler=scheduler, workers=count,
                 progress=lambda done, total: bar.update(task, completed=done),
+                notify=lambda line: console.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True),
             )  # fmt: skip
     except (SweepError, OutputError) as exc:
         _fail(str(exc))

@@ -9,8 +9,9 @@ The pieces, in the order data flows:
   one (:func:`tmem.simulate`), and turns each into a row of metrics;
 * :mod:`tmem.sweep.store` keeps the rows on disk as Parquet parts written as
   tasks finish, so an interrupted sweep resumes where it stopped;
-* :mod:`tmem.sweep.runner` hands the chunks to a Dask cluster (local, or an
-  existing one by address) and collects them;
+* :mod:`tmem.sweep.runner` hands the chunks to a Dask cluster
+  (:mod:`tmem.sweep.cluster`: local, or an existing one by address, checked)
+  and collects them;
 * :mod:`tmem.sweep.report` writes ``summary.md`` and the figures.
 """
 

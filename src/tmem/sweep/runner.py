@@ -4,8 +4,9 @@
 leaves out the cases already done, groups the others into chunks
 (:func:`tmem.sweep.tasks.plan_chunks`), submits one task per chunk and
 writes rows as tasks finish.  The local cluster and a remote one take the
-same path: a :class:`dask.distributed.Client` and its futures.  A remote
-cluster's workers need tmem installed, in the same version.
+same path: a :class:`dask.distributed.Client` and its futures
+(:mod:`tmem.sweep.cluster`).  A remote cluster's workers need tmem
+installed, in the same version.
 
 Nothing is lost when a sweep stops early: on Ctrl-C the rows received are
 written before :class:`SweepInterrupted` is raised (SIGTERM and SIGHUP alike); a killed worker's tasks
@@ -19,9 +20,7 @@ case that raises.
 
 from __future__ import annotations
 
-import logging
 import math
-import os
 import signal
 import threading
 import time
@@ -33,8 +32,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from .cluster import check_workers, dask_client, takes_signals
 from .report import write_report
-from .spec import Sweep, SweepError
+from .spec import Sweep
 from .store import ResultStore
 from .tasks import one_line, plan_chunks, row, run_chunk
 
@@ -76,59 +76,6 @@ class SweepOutcome:
     seconds: float
 
 
-def _takes_signals() -> bool:
-    """Only the main thread can install signal handlers."""
-    return threading.current_thread() is threading.main_thread()
-
-
-@contextmanager
-def dask_client(scheduler: str | None, workers: int | None) -> Iterator:
-    """A client of the cluster at ``scheduler``, or of a new local cluster of ``workers`` processes.
-
-    Parameters
-    ----------
-    scheduler : str or None
-        Address of an existing Dask scheduler; ``None`` starts a local cluster.
-    workers : int or None
-        Worker processes of the local cluster; ``None``: one per core.
-    """
-    from dask.distributed import Client, LocalCluster
-
-    if scheduler:
-        try:
-            client = Client(scheduler, timeout="20s", set_as_default=False)  # a failed one must not linger as the default
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise SweepError(f"--scheduler {scheduler}: cannot connect ({one_line(exc)})") from None
-        try:
-            yield client
-        finally:
-            client.close()
-        return
-    # Ctrl-C reaches every process of the terminal's group.  The worker processes are started with
-    # SIGINT ignored (they inherit it), so that only this process answers it: it saves the rows it
-    # has and shuts the cluster down, instead of every worker dying with a traceback.
-    main_thread = _takes_signals()
-    interrupt = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
-    try:
-        cluster = LocalCluster(
-            n_workers=workers or os.cpu_count() or 1,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",
-            silence_logs=logging.ERROR,
-            env={"NUMBA_NUM_THREADS": "1"},  # one process per core; no threads within
-        )  # fmt: skip
-    finally:
-        if main_thread:
-            signal.signal(signal.SIGINT, interrupt)
-    client = Client(cluster, set_as_default=False)
-    try:
-        yield client
-    finally:
-        client.close()
-        cluster.close()
-
-
 @contextmanager
 def _ctrl_c_as_flag() -> Iterator[threading.Event]:
     """While the sweep runs, Ctrl-C (and SIGTERM, SIGHUP) set a flag that the collecting loop reads between tasks.
@@ -139,7 +86,7 @@ def _ctrl_c_as_flag() -> Iterator[threading.Event]:
     flag is never set.  A signal set to be ignored stays ignored.)
     """
     flag = threading.Event()
-    if not _takes_signals():
+    if not takes_signals():
         yield flag
         return
     previous = {}
@@ -160,6 +107,7 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> SweepOutcome:
     """Run every case of ``sweep`` not yet done in ``out``; write the table, ``summary.md`` and figures.
 
@@ -176,12 +124,16 @@ def run_sweep(
         Worker processes of the local cluster; ``None``: one per core.
     progress
         Called as ``progress(cases_done, cases_total)`` as tasks finish.
+    notify
+        Called as ``notify(line)`` when a file of rows that cannot be read is
+        set aside and its cases run again; by default a :class:`UserWarning`.
 
     Raises :class:`SweepInterrupted` on Ctrl-C, after saving what finished.
     """
     started = time.perf_counter()
     out = Path(out)
-    store = ResultStore.check(out, sweep)
+    workers = check_workers(workers, scheduler)
+    store = ResultStore.check(out, sweep, notify)
     metrics = store.metrics
     with ExitStack() as held:
         if store.exists:

@@ -6,7 +6,10 @@ The output directory of ``tmem sweep`` holds:
   fingerprint (:attr:`tmem.sweep.spec.Sweep.fingerprint`) and case count;
 * ``parts/part-*.parquet``: the rows of finished tasks, while the sweep runs.
   Each part is written under a temporary name and renamed when complete, so
-  a part on disk is whole, and the cases in it are done;
+  a part on disk is whole, and the cases in it are done.  Its pages carry
+  checksums: a part (or ``results.parquet``) that cannot be read whole, or
+  whose rows are not this sweep's, is set aside as ``NAME.corrupt`` in the
+  directory (never deleted), said in one line, and its cases run again;
 * ``results.parquet``: every row, one per case, sorted by case, once every
   case is done (the parts are then removed);
 * ``summary.md`` and the figures (:mod:`tmem.sweep.report`).
@@ -30,12 +33,13 @@ from __future__ import annotations
 import json
 import re
 import uuid
-from collections.abc import Iterator
+import warnings
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
-import pyarrow.parquet as pq
+import pyarrow as pa
 
 from .. import __version__
 from ..outputs import (
@@ -52,6 +56,10 @@ from .spec import Sweep
 
 RESULTS = "results.parquet"
 PARTS = "parts"
+#: Appended to the name of a file of rows that cannot be read, set aside in the sweep's directory.
+CORRUPT = ".corrupt"
+#: What reading a damaged Parquet file may raise.
+_UNREADABLE = (pa.ArrowException, OSError, ValueError, TypeError, KeyError, IndexError, MemoryError, NotImplementedError)
 #: Temporary files of an earlier tmem (no process id in the name), removed under the lock.
 _OLD_TEMPORARY = re.compile(r"\.(results\.parquet|part-[0-9]+-[0-9a-f]{8}\.parquet)\.[0-9a-f]{8}\.tmp")
 
@@ -66,15 +74,19 @@ class ResultStore:
         after checking it.
     sweep : Sweep
         The sweep whose rows it holds (:func:`tmem.sweep.load_sweep`).
+    notify : callable, optional
+        ``notify(line)`` is told, in one line, of a file of rows set aside as
+        corrupt; by default a :class:`UserWarning`.
     """
 
-    def __init__(self, out: Path, sweep: Sweep):
+    def __init__(self, out: Path, sweep: Sweep, notify: Callable[[str], None] | None = None):
         self.out = out
         self.sweep = sweep
         self.metrics = tuple(sweep.spec.metrics)
+        self.notify = notify or (lambda line: warnings.warn(line, stacklevel=4))
 
     @classmethod
-    def check(cls, out: str | Path, sweep: Sweep) -> "ResultStore":
+    def check(cls, out: str | Path, sweep: Sweep, notify: Callable[[str], None] | None = None) -> "ResultStore":
         """The store of ``sweep`` at ``out``: new, empty, or holding this sweep's results so far.
 
         Reads only: nothing is written until :meth:`opened`.
@@ -85,6 +97,8 @@ class ResultStore:
             The sweep's output directory (``--out``).
         sweep : Sweep
             The sweep to run there.
+        notify : callable, optional
+            Told of a file of rows set aside as corrupt (see :class:`ResultStore`).
 
         Raises
         ------
@@ -94,7 +108,7 @@ class ResultStore:
         out = Path(out)
         check_directory(out, "sweep", adopt=lambda directory: _only_a_first_sweep_toml(directory, sweep))
         _check_identity(out, sweep)
-        return cls(out, sweep)
+        return cls(out, sweep, notify)
 
     @property
     def exists(self) -> bool:
@@ -143,11 +157,45 @@ class ResultStore:
         parts = self.out / PARTS
         return ([results] if results.exists() else []) + (sorted(parts.glob("part-*.parquet")) if parts.is_dir() else [])
 
+    def _read(self, path: Path) -> pd.DataFrame | None:
+        """The rows in ``path``; None once it is set aside, if it cannot be read whole or its rows are not this sweep's."""
+        try:
+            frame = pd.read_parquet(path, page_checksum_verification=True)
+            self._check_rows(frame)
+        except _UNREADABLE as exc:
+            self._set_aside(path, " ".join(f"{exc.__class__.__name__}: {exc}".split())[:200])
+            return None
+        return frame
+
+    def _check_rows(self, frame: pd.DataFrame) -> None:
+        """Raise ValueError unless ``frame`` has the columns of this sweep's rows and case numbers within it."""
+        needed = {"case", *self.metrics, "error", "seconds"}
+        if not needed <= set(frame.columns) <= needed | set(self.sweep.parameters):
+            raise ValueError("its columns are not this sweep's")
+        cases = frame["case"]
+        if not pd.api.types.is_integer_dtype(cases) or not cases.between(0, self.sweep.n_cases - 1).all():
+            raise ValueError("its case numbers are not this sweep's")
+
+    def _set_aside(self, path: Path, why: str) -> None:
+        """Rename ``path`` to a free ``NAME.corrupt`` (``NAME.2.corrupt``, …) in the sweep's directory; say so."""
+        target, n = self.out / f"{path.name}{CORRUPT}", 1
+        while target.exists() or target.is_symlink():
+            n += 1
+            target = self.out / f"{path.name}.{n}{CORRUPT}"
+        shown = path.relative_to(self.out)
+        try:
+            path.rename(target)
+        except OSError as exc:
+            raise OutputError(f"--out {self.out}: {shown} cannot be read ({why}) nor set aside ({exc.strerror or exc})") from None
+        self.notify(f"{shown} in {self.out} cannot be read ({why}); set aside as {target.name}, its cases run again")
+
     def done_cases(self) -> set[int]:
-        """The cases with a row on disk."""
+        """The cases with a row on disk; a file of rows that cannot be read is set aside, its cases not done."""
         done: set[int] = set()
         for path in self._files():
-            done.update(pq.read_table(path, columns=["case"]).column("case").to_pylist())
+            frame = self._read(path)
+            if frame is not None:
+                done.update(frame["case"].tolist())
         return done
 
     def add(self, rows: list[dict]) -> None:
@@ -163,7 +211,7 @@ class ResultStore:
             return
         frame = self._frame(rows)
         name = f"part-{int(frame['case'].min()):09d}-{uuid.uuid4().hex[:8]}.parquet"
-        write_atomically(self.out / PARTS / name, lambda tmp: frame.to_parquet(tmp, index=False))
+        write_atomically(self.out / PARTS / name, lambda tmp: frame.to_parquet(tmp, index=False, write_page_checksum=True))
 
     def _frame(self, rows: list[dict]) -> pd.DataFrame:
         """Rows as a table with the same column types in every part."""
@@ -177,11 +225,11 @@ class ResultStore:
         return frame
 
     def table(self) -> pd.DataFrame:
-        """Every row on disk, one per case, sorted by case."""
-        files = self._files()
-        if not files:
+        """Every row on disk, one per case, sorted by case (a file that cannot be read is set aside)."""
+        frames = [frame for frame in map(self._read, self._files()) if frame is not None]
+        if not frames:
             return pd.DataFrame(columns=["case", *self.sweep.parameters, *self.metrics, "error", "seconds"])
-        frame = pd.concat([pd.read_parquet(path) for path in files], ignore_index=True)
+        frame = pd.concat(frames, ignore_index=True)
         return frame.drop_duplicates("case").sort_values("case", ignore_index=True)
 
     def finish(self) -> pd.DataFrame:
@@ -189,7 +237,7 @@ class ResultStore:
         frame = self.table()
         if len(frame) != self.sweep.n_cases:
             raise RuntimeError(f"finish: {len(frame)} of {self.sweep.n_cases} cases have rows")
-        write_atomically(self.out / RESULTS, lambda tmp: frame.to_parquet(tmp, index=False))
+        write_atomically(self.out / RESULTS, lambda tmp: frame.to_parquet(tmp, index=False, write_page_checksum=True))
         parts = self.out / PARTS
         if parts.is_dir():
             for part in parts.glob("part-*.parquet"):
