@@ -307,3 +307,12 @@ def test_the_python_api_checks_workers_alike(tmp_path):
         run_sweep(sweep, tmp_path / "out", workers=0)
     assert not (tmp_path / "out").exists()
     assert check_workers(None) is None and check_workers(3) == 3 and check_workers(" 2 ") == 2
+
+
+def test_a_sweep_output_path_is_printed_as_written(threads, sweep_file, tmp_path, monkeypatch):
+    """Rich markup in --out is text: the last line names the folder the rows went to."""
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, ["sweep", str(sweep_file), "--out", "[bold]y", "--scheduler", threads])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[-1].endswith("written to [bold]y/results.parquet and [bold]y/summary.md")
+    assert (tmp_path / "[bold]y" / "results.parquet").is_file()

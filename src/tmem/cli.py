@@ -236,7 +236,7 @@ def sweep_command(
     except SweepInterrupted as exc:
         console.print(escape(str(exc)), highlight=False)
         raise typer.Exit(130) from None
-    Console().print(
+    _say(
         f"{len(outcome.table)} cases ({outcome.ran} run now, {outcome.failed} failed) in {outcome.seconds:.1f} s; "
         f"written to {out}/results.parquet and {out}/summary.md"
     )
