@@ -145,47 +145,13 @@ def run_sweep(
         if progress:
             progress(done, sweep.n_cases)
         if todo:
-            waiting: list[dict] = []
-            lost = ""
-            last_flush = -math.inf  # the first rows go to disk at once
             with _ctrl_c_as_flag() as ctrl_c, dask_client(scheduler, workers) as client:
-                from dask.distributed import as_completed
-
                 if not store.exists:  # made only once the cluster answers: a bad --scheduler leaves nothing
                     held.enter_context(store.opened())
                 base = client.scatter(sweep.base, broadcast=True)
                 chunks = plan_chunks(sweep.base, todo, metrics, sweep.spec.batch)
                 futures = {client.submit(run_chunk, base, chunk, metrics, pure=False): chunk for chunk in chunks}
-                finished = as_completed(futures, loop=client.loop)
-                try:
-                    while not finished.is_empty():
-                        if ctrl_c.is_set():
-                            raise KeyboardInterrupt
-                        ready = finished.next_batch(block=False)
-                        if not ready:
-                            time.sleep(POLL_SECONDS)
-                        for future in ready:
-                            chunk = futures.pop(future)
-                            try:
-                                waiting += future.result()
-                                ran += len(chunk)
-                            except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
-                                lost = f"{one_line(exc)} (from the cluster)"
-                            except Exception as exc:  # e.g. a worker killed again and again by this chunk
-                                waiting += [row(case, metrics, None, one_line(exc), None) for case in chunk]
-                                ran += len(chunk)
-                        if waiting and (len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS):
-                            store.add(waiting)
-                            waiting, last_flush = [], time.perf_counter()
-                        if progress and ready:
-                            progress(done + ran, sweep.n_cases)
-                    if ctrl_c.is_set():  # came as the last tasks finished: still a stop, not a finish
-                        raise KeyboardInterrupt
-                    store.add(waiting)
-                except KeyboardInterrupt:
-                    store.add(waiting)
-                    client.cancel(list(futures))
-                    raise SweepInterrupted(done + ran, sweep.n_cases) from None
+                ran, lost = _collect(client, futures, store, metrics, ctrl_c, progress, done, sweep.n_cases)
             if lost:
                 raise SweepInterrupted(done + ran, sweep.n_cases, why=f"tasks lost, {lost}")
         if not store.exists:  # a sweep of no cases
@@ -193,3 +159,50 @@ def run_sweep(
         table = store.finish()
         write_report(table, sweep, out)
     return SweepOutcome(table=table, ran=ran, failed=int(table["error"].notna().sum()), seconds=time.perf_counter() - started)
+
+
+def _collect(
+    client, futures: dict, store: ResultStore, metrics, ctrl_c, progress, done: int, total: int
+) -> tuple[int, str]:
+    """Save the rows of ``futures`` (future -> its chunk of cases) as they finish, in batches.
+
+    Returns the number of cases run and why tasks were lost ("" if none were).  Raises
+    :class:`SweepInterrupted` once ``ctrl_c`` is set, after saving the rows that came back.
+    """
+    from dask.distributed import as_completed
+
+    waiting: list[dict] = []
+    ran = 0
+    lost = ""
+    last_flush = -math.inf  # the first rows go to disk at once
+    finished = as_completed(futures, loop=client.loop)
+    try:
+        while not finished.is_empty():
+            if ctrl_c.is_set():
+                raise KeyboardInterrupt
+            ready = finished.next_batch(block=False)
+            if not ready:
+                time.sleep(POLL_SECONDS)
+            for future in ready:
+                chunk = futures.pop(future)
+                try:
+                    waiting += future.result()
+                    ran += len(chunk)
+                except (CancelledError, OSError) as exc:  # the cluster's failure, not the cases': no rows
+                    lost = f"{one_line(exc)} (from the cluster)"
+                except Exception as exc:  # e.g. a worker killed again and again by this chunk
+                    waiting += [row(case, metrics, None, one_line(exc), None) for case in chunk]
+                    ran += len(chunk)
+            if waiting and (len(waiting) >= FLUSH_ROWS or time.perf_counter() - last_flush > FLUSH_SECONDS):
+                store.add(waiting)
+                waiting, last_flush = [], time.perf_counter()
+            if progress and ready:
+                progress(done + ran, total)
+        if ctrl_c.is_set():  # came as the last tasks finished: still a stop, not a finish
+            raise KeyboardInterrupt
+        store.add(waiting)
+    except KeyboardInterrupt:
+        store.add(waiting)
+        client.cancel(list(futures))
+        raise SweepInterrupted(done + ran, total) from None
+    return ran, lost
