@@ -47,6 +47,15 @@ def all_pairs(active: np.ndarray) -> np.ndarray:
     return np.stack([flying[first], flying[second]], axis=1).astype(np.uint32)
 
 
+@numba.njit(cache=True, inline="always")
+def _cell_count(shape):
+    """The number of cells of a grid of ``shape``."""
+    count = 1
+    for k in shape:
+        count *= k
+    return count
+
+
 @numba.njit(cache=True)
 def _cells(points, active, cutoff, box):
     """Bin active points into a grid of cells of side >= cutoff; counting sort by cell.
@@ -54,11 +63,14 @@ def _cells(points, active, cutoff, box):
     Returns ``(cell_of, n_cells_per_axis, start, order)``: the cell of each point
     (-1 if inactive), the grid shape, and the points sorted by cell with the
     first index of each cell.
+
+    Only ``np.empty`` and loops: each other NumPy function Numba compiles on
+    first use, and a two-agent run pays for every one of them.
     """
     n, axes = points.shape
-    lo = np.zeros(axes)
-    shape = np.ones(axes, dtype=np.int64)
-    size = np.ones(axes)
+    lo = np.empty(axes)
+    shape = np.empty(axes, dtype=np.int64)
+    size = np.empty(axes)
     for a in range(axes):
         if box[a] > 0.0:
             lo[a] = 0.0
@@ -77,8 +89,11 @@ def _cells(points, active, cutoff, box):
             shape[a] = max(1, int((high - low) // cutoff))
             size[a] = max(cutoff, (high - low) / shape[a] + 1e-9 * cutoff)
     # Never more cells than about 2 per agent along all axes together.
-    while np.prod(shape) > 2 * n + 8:
-        a = np.argmax(shape)
+    while _cell_count(shape) > 2 * n + 8:
+        a = 0
+        for b in range(1, axes):  # the axis with the most cells, the first of equals
+            if shape[b] > shape[a]:
+                a = b
         halved = max(1, shape[a] // 2)
         if box[a] > 0.0:
             shape[a] = halved if halved >= 3 else 1  # as above: never 2 cells round a periodic axis
@@ -86,10 +101,12 @@ def _cells(points, active, cutoff, box):
         else:
             size[a] = size[a] * shape[a] / halved
             shape[a] = halved
-    n_cells = np.prod(shape)
-    cell_of = np.full(n, -1, dtype=np.int64)
-    count = np.zeros(n_cells + 1, dtype=np.int64)
+    n_cells = _cell_count(shape)
+    cell_of = np.empty(n, dtype=np.int64)
+    start = np.empty(n_cells + 1, dtype=np.int64)  # counts first, then where each cell starts
+    start[:] = 0
     for i in range(n):
+        cell_of[i] = -1
         if active[i]:
             c = 0
             for a in range(axes):
@@ -99,10 +116,13 @@ def _cells(points, active, cutoff, box):
                 k = min(int(position / size[a]), shape[a] - 1)
                 c = c * shape[a] + k
             cell_of[i] = c
-            count[c + 1] += 1
-    start = np.cumsum(count)
-    fill = start[:-1].copy()
-    order = np.empty(start[-1], dtype=np.int64)
+            start[c + 1] += 1
+    for c in range(n_cells):
+        start[c + 1] += start[c]
+    fill = np.empty(n_cells, dtype=np.int64)
+    for c in range(n_cells):
+        fill[c] = start[c]
+    order = np.empty(start[n_cells], dtype=np.int64)
     for i in range(n):
         if cell_of[i] >= 0:
             order[fill[cell_of[i]]] = i
@@ -353,7 +373,9 @@ def arrange(pairs, n_pairs, adj_ptr, adj_idx, block, block_ptr):
             n_crossing += 1
     for b in range(block_ptr.shape[0] - 1):
         block_ptr[b + 1] += block_ptr[b]
-    pairs[n_inside : n_inside + n_crossing] = crossing[:n_crossing]
+    for e in range(n_crossing):  # element by element: a slice copy compiles Numba's shape-error messages, seconds
+        pairs[n_inside + e, 0] = crossing[e, 0]
+        pairs[n_inside + e, 1] = crossing[e, 1]
     return n_inside, n_inside + n_crossing
 
 
