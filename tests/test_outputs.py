@@ -72,6 +72,25 @@ def test_dataset_matches_summary_and_carries_units_and_scenario(fig9_run):
         assert coupled.max() == pytest.approx(s["uncouple_time"], abs=0.01)
 
 
+@pytest.mark.parametrize("scenario", ["fig9.toml", "swarm/ring8_loss.toml"])
+def test_trajectory_file_reads_back_as_xarray_writes_it(scenario, tmp_path):
+    """tmem writes trajectory.nc through h5netcdf directly; read back, it is what xarray's own writer gives."""
+    from tmem.io import to_dataset, write_netcdf
+
+    trajectory = tmem.simulate(tmem.load(EXAMPLES / scenario))
+    to_dataset(trajectory).to_netcdf(tmp_path / "by_xarray.nc", engine="h5netcdf")
+    write_netcdf(trajectory, tmp_path / "by_tmem.nc")
+    with xr.open_dataset(tmp_path / "by_xarray.nc", engine="h5netcdf") as expected, \
+            xr.open_dataset(tmp_path / "by_tmem.nc", engine="h5netcdf") as got:  # fmt: skip
+        xr.testing.assert_identical(got, expected)
+        assert set(got.coords) == {"time", "agent", "axis", "pair", "pair_i", "pair_j"}
+        for name in list(expected.variables):
+            assert got[name].dtype == expected[name].dtype, name
+            assert got[name].encoding.get("dtype") == expected[name].encoding.get("dtype"), name
+            assert np.isnan(got[name].encoding["_FillValue"]) if "_FillValue" in expected[name].encoding \
+                else "_FillValue" not in got[name].encoding, name  # fmt: skip
+
+
 def test_rerun_replaces_an_earlier_run(tmp_path):
     out = tmp_path / "o"
     runner = CliRunner()

@@ -1,39 +1,57 @@
-"""Run outputs: the trajectory as an xarray dataset, and run directories.
+"""Run outputs: the trajectory as a NetCDF file or an xarray dataset, and run directories.
 
 A run directory holds ``summary.json`` (:func:`tmem.metrics.summarize`),
-``trajectory.nc`` (:func:`to_dataset`, NetCDF-4 via h5netcdf) and the figures
-of :mod:`tmem.plot`, and the manifest ``.tmem-output.json``.  When a
-directory may be replaced, and how an interrupted run leaves nothing behind,
-is :mod:`tmem.outputs`'s.
+``trajectory.nc`` (:func:`write_netcdf`, NetCDF-4) and the figures of
+:mod:`tmem.plot`, and the manifest ``.tmem-output.json``.  When a directory
+may be replaced, and how an interrupted run leaves nothing behind, is
+:mod:`tmem.outputs`'s.
+
+What the file holds is described once (:func:`contents`); :func:`to_dataset`
+makes an :class:`xarray.Dataset` of it, and :func:`write_netcdf` writes it
+through h5netcdf directly, as xarray would, without loading xarray, pandas
+and Dask (a second and a half of a two-second command).
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
-import xarray as xr
 
 from . import __version__, metrics, plot
 from .engine import Trajectory
 from .outputs import OutputError, check_directory, replace_directory
 
-__all__ = ["OutputError", "check_output_directory", "to_dataset", "write_run", "write_run_files"]
+__all__ = ["OutputError", "check_output_directory", "contents", "to_dataset", "write_netcdf", "write_run", "write_run_files"]
 
 PAPER = "E. Heiss, A. Kozyr, O. Morozov, Formations Organization in Robotic Swarm Using the Thermal Motion Equivalent Method"
 
-def to_dataset(trajectory: Trajectory) -> xr.Dataset:
-    """The recorded trajectory as an :class:`xarray.Dataset`.
+
+class Contents(NamedTuple):
+    """A trajectory file's variables: each name maps to ``(dims, values, attributes)``.
+
+    ``coords`` holds the dimension coordinates and ``pair_i``, ``pair_j``; ``data`` the variables;
+    ``attrs`` the file's attributes.
+    """
+
+    coords: dict[str, tuple[tuple[str, ...], np.ndarray, dict]]
+    data: dict[str, tuple[tuple[str, ...], np.ndarray, dict]]
+    attrs: dict
+
+
+def contents(trajectory: Trajectory) -> Contents:
+    """What ``trajectory.nc`` holds.
 
     Dimensions ``time``, ``agent`` (the recorded agents, by index), ``axis``
-    and ``pair``; variables ``P``, ``V``, ``phi``, ``omega`` and the control
-    ``U`` over (time, agent, axis); ``active`` over (time, agent); the
-    coupling flag ``F_en``, the distance and the interaction distance ``|d|``
-    (6) over (time, pair); each pair's set distance ``d_t``; the RMS velocity
-    of the recorded agents over time.  Units are in each variable's
-    attributes; the scenario (as TOML), the gains and the events are in the
-    dataset's attributes.
+    and ``pair``; variables ``P``, ``V``, ``phi``, ``omega`` (the vehicle
+    model's state names) and the control ``U`` over (time, agent, axis);
+    ``active`` over (time, agent); the coupling flag ``F_en``, the distance and
+    the interaction distance ``|d|`` (6) over (time, pair); each pair's set
+    distance ``d_t``; the RMS velocity of the recorded agents over time.  Units
+    are in each variable's attributes; the scenario (as TOML), the gains and the
+    events are in the file's attributes.
 
     Parameters
     ----------
@@ -42,12 +60,12 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
     """
     n_axes = trajectory.scenario.space.axes
     coords = {
-        "time": ("time", trajectory.time, {"units": "s"}),
-        "agent": trajectory.agents,
-        "axis": ["x", "y", "z"][:n_axes],
-        "pair": np.arange(len(trajectory.pairs)),
-        "pair_i": ("pair", trajectory.pairs[:, 0], {"long_name": "first agent of the pair"}),
-        "pair_j": ("pair", trajectory.pairs[:, 1], {"long_name": "second agent of the pair"}),
+        "time": (("time",), trajectory.time, {"units": "s"}),
+        "agent": (("agent",), trajectory.agents, {}),
+        "axis": (("axis",), np.array(["x", "y", "z"][:n_axes]), {}),
+        "pair": (("pair",), np.arange(len(trajectory.pairs), dtype=np.int64), {}),
+        "pair_i": (("pair",), trajectory.pairs[:, 0], {"long_name": "first agent of the pair"}),
+        "pair_j": (("pair",), trajectory.pairs[:, 1], {"long_name": "second agent of the pair"}),
     }
     over_agents = ("time", "agent", "axis")
     over_pairs = ("time", "pair")
@@ -64,7 +82,7 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
         trajectory.interaction_distance,
         {"long_name": "interaction distance |P*_j - P*_i|, (6)", "units": "m"},
     )
-    data["d_t"] = ("pair", trajectory.d_t, {"long_name": "set distance of the pair", "units": "m"})
+    data["d_t"] = (("pair",), trajectory.d_t, {"long_name": "set distance of the pair", "units": "m"})
     data["rms_velocity"] = (
         ("time",),
         metrics.rms_velocity(model.velocity(trajectory.state), trajectory.active),
@@ -79,7 +97,56 @@ def to_dataset(trajectory: Trajectory) -> xr.Dataset:
         "gains_order": "K_P K_V K_phi K_omega",
         "events": json.dumps(metrics.summarize_events(trajectory.events)),
     }
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return Contents(coords, data, attrs)
+
+
+def to_dataset(trajectory: Trajectory):
+    """The recorded trajectory as an :class:`xarray.Dataset` (the variables of :func:`contents`).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    """
+    import xarray as xr
+
+    c = contents(trajectory)
+    return xr.Dataset(c.data, coords=c.coords, attrs=c.attrs)
+
+
+def write_netcdf(trajectory: Trajectory, path: Path) -> None:
+    """Write :func:`contents` to ``path`` as NetCDF-4, as ``to_dataset(trajectory).to_netcdf(path)`` would.
+
+    As xarray writes it: floating-point variables with ``_FillValue = NaN``,
+    strings as variable-length strings, and each variable over ``pair`` naming
+    ``pair_i pair_j`` in its ``coordinates`` attribute, so that readers take
+    those two as coordinates.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    path : Path
+        The file to write.
+    """
+    import h5netcdf
+    import h5py
+
+    c = contents(trajectory)
+    pair_coords = [name for name, (dims, _, _) in c.coords.items() if dims == ("pair",) and name != "pair"]
+    with h5netcdf.File(path, "w") as f:
+        f.dimensions = {name: len(values) for name, (dims, values, _) in c.coords.items() if dims == (name,)}
+        for name, (dims, values, attrs) in {**c.coords, **c.data}.items():
+            if values.dtype.kind == "U":
+                variable = f.create_variable(name, dims, dtype=h5py.string_dtype())
+                variable[...] = values.astype(object)
+            else:
+                fill = np.nan if values.dtype.kind == "f" else None
+                variable = f.create_variable(name, dims, data=values, fillvalue=fill)
+            variable.attrs.update(attrs)
+            if "pair" in dims and name not in c.coords:
+                variable.attrs["coordinates"] = " ".join(pair_coords)
+        f.attrs.update(c.attrs)
 
 
 def check_output_directory(out: str | Path) -> Path:
@@ -105,7 +172,7 @@ def write_run_files(trajectory: Trajectory, directory: Path) -> dict:
     """
     summary = metrics.summarize(trajectory)
     (directory / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    to_dataset(trajectory).to_netcdf(directory / "trajectory.nc", engine="h5netcdf")
+    write_netcdf(trajectory, directory / "trajectory.nc")
     plot.write_figures(trajectory, directory)
     return summary
 

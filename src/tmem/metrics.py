@@ -10,7 +10,6 @@ angle to it), over the recorded samples.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .engine import Event, Trajectory
 
@@ -50,6 +49,8 @@ def nearest_distance(positions: np.ndarray, active: np.ndarray, box: np.ndarray)
     points = positions[active]
     if len(points) < 2:
         return None
+    from scipy.spatial import cKDTree  # here, not at the top: loading it takes longer than a two-agent run
+
     periodic = bool(np.all(box > 0))
     tree = cKDTree(np.mod(points, box) if periodic else points, boxsize=box if periodic else None)
     distances, _ = tree.query(np.mod(points, box) if periodic else points, k=2)

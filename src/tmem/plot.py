@@ -12,14 +12,11 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure  # not pyplot: writing a file needs no window and no figure manager
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from . import metrics  # noqa: E402
-from .engine import Trajectory  # noqa: E402
+from . import metrics
+from .engine import Trajectory
 
 #: Matplotlib's warning for a character its font lacks (a name in CJK, an emoji).
 MISSING_GLYPH = r"Glyph \d+ .* missing from font"
@@ -54,7 +51,8 @@ def velocity_figure(trajectory: Trajectory):
     trajectory : Trajectory
         A run (:func:`tmem.simulate`).
     """
-    fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    ax = fig.subplots()
     t = trajectory.time
     velocity = trajectory.model.velocity(trajectory.state)
     one_axis = velocity.shape[2] == 1
@@ -80,9 +78,8 @@ def distance_figure(trajectory: Trajectory):
     trajectory : Trajectory
         A run (:func:`tmem.simulate`).
     """
-    fig, (top, bottom) = plt.subplots(
-        2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained"
-    )
+    fig = Figure(figsize=(8, 6), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
     t = trajectory.time
     ia = trajectory.scenario.interaction
     for p in np.argsort(trajectory.min_distance)[:MAX_DRAWN]:
@@ -113,7 +110,8 @@ def formation_figure(trajectory: Trajectory):
     trajectory : Trajectory
         A run (:func:`tmem.simulate`).
     """
-    fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    ax = fig.subplots()
     coupled = trajectory.flag == 1
     error = np.where(coupled, np.abs(trajectory.pair_distance - trajectory.d_t), 0.0)
     count = coupled.sum(axis=1)
@@ -164,6 +162,5 @@ def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
         with warnings.catch_warnings():  # a name in a script the font lacks is drawn as boxes, without a warning per glyph
             warnings.filterwarnings("ignore", message=MISSING_GLYPH, category=UserWarning)
             fig.savefig(path, dpi=120)
-        plt.close(fig)
         paths.append(path)
     return paths
