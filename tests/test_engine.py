@@ -138,7 +138,7 @@ def test_each_agent_corrected_position_uses_its_own_gains():
     law = Law(gains, 0, 0, False, False, 0.2)
     run = Run(10, 1, (0.0,) * axes, False, 1.0)
     neighbours = Neighbours(np.empty((0, 2), dtype=np.uint32), 0, 0, np.zeros(2, dtype=np.int64), np.zeros((n, axes)),
-                            np.empty(1), np.full(1, np.inf), np.empty((2, 2 * axes + 1, 8)))  # fmt: skip
+                            np.empty(1), np.empty(2), np.full(1, np.inf), np.empty((2, 2 * axes + 1, 8)))  # fmt: skip
     corrected_positions(state, agents, law, run, neighbours)
     expected = np.stack([interaction_point(state[i], gains[i]) for i in range(n)])
     np.testing.assert_allclose(agents.corrected[:, :, 0], expected, rtol=1e-13)

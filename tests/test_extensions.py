@@ -90,7 +90,8 @@ EXTENSIONS = {
             for i in range(state.shape[0]):
                 for a in range(state.shape[1]):
                     known[i, a, 0] = np.round(state[i, a, 0] / sensing.quantum) * sensing.quantum
-                    known[i, a, 1:] = state[i, a, 1:]
+                    for m in range(1, state.shape[2]):  # element by element: the serial loop has no runtime
+                        known[i, a, m] = state[i, a, m]
             return known
         '''), "    ")),
     ],

@@ -220,7 +220,7 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
     hold = model.step_params(sim.dt)
-    law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r), 2)
+    law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r))
     cases = len(positions)
     start = np.zeros((cases, 2, 4))
     start[:, :, 0] = positions

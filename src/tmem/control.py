@@ -169,10 +169,11 @@ def corrected_position(p, v, phi, omega, gains, agent):
     ----------
     p, v, phi, omega : float
         Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
-    gains : ndarray, shape (agents, 4)
-        Each agent's ``K`` (:func:`modal_gains`); indexed in place, since a row taken out as an
-        array would cost a reference count at every agent.
+    gains : ndarray, shape (agents, 4) or (1, 4)
+        Each agent's ``K`` (:func:`modal_gains`), or one row that every agent shares; indexed in
+        place, since a row taken out as an array would cost a reference count at every agent.
     agent : int
-        The row of the agent.
+        The agent's row when there is a row per agent.
     """
-    return (p * gains[agent, 0] + v * gains[agent, 1] + phi * gains[agent, 2] + omega * gains[agent, 3]) / gains[agent, 0]
+    row = agent if gains.shape[0] > 1 else 0  # one row shared: no stream of identical rows through the cache
+    return (p * gains[row, 0] + v * gains[row, 1] + phi * gains[row, 2] + omega * gains[row, 3]) / gains[row, 0]

@@ -61,7 +61,7 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
     return steps
 
 
-def law_of(scenario: Scenario, gains: np.ndarray, n_agents: int) -> tuple[Law, FunctionParams]:
+def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
     """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters.
 
     Parameters
@@ -69,9 +69,8 @@ def law_of(scenario: Scenario, gains: np.ndarray, n_agents: int) -> tuple[Law, F
     scenario : Scenario
         The scenario whose ``[interaction]`` table sets the law.
     gains : ndarray, shape (4,)
-        ``K`` placing the roots (5) (:func:`tmem.control.gains_for`), every agent's.
-    n_agents : int
-        Agents of the run: the law holds a row of gains for each.
+        ``K`` placing the roots (5) (:func:`tmem.control.gains_for`), every agent's: the law holds it
+        as one row that all agents share.
 
     Returns
     -------
@@ -81,7 +80,7 @@ def law_of(scenario: Scenario, gains: np.ndarray, n_agents: int) -> tuple[Law, F
     ia = scenario.interaction
     couples = uses_coupling(ia.function)
     law = Law(
-        gains=np.tile(gains, (n_agents, 1)),
+        gains=gains[np.newaxis, :],
         function=code(ia.function),
         neighbour_function=code("repulsion") if couples else code(ia.function),
         couples=couples,
@@ -126,6 +125,7 @@ class _NeighbourLister:
         self.adj_ptr, self.adj_idx = _partners(n_agents, edges_in_slots)
         self.block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
         self.block_nearest2 = np.empty(len(self.block_ptr) - 1)
+        self.block_shift2 = np.empty(len(self.block_ptr) - 1)
         self.chunks = np.empty((len(self.block_ptr), 2 * n_axes + 1, CHUNK))
         self.closest = np.full(1, np.inf)  # the smallest squared distance between neighbours so far
         self.p_ref = np.zeros((n_agents, n_axes))
@@ -148,8 +148,8 @@ class _NeighbourLister:
             self.pairs = all_pairs(active)
             listed = len(self.pairs)
         n_inside, n_pairs = arrange(self.pairs, listed, self.adj_ptr, self.adj_idx, BLOCK, self.block_ptr)
-        return Neighbours(self.pairs, n_inside, n_pairs, self.block_ptr, self.p_ref, self.block_nearest2, self.closest,
-                          self.chunks)  # fmt: skip
+        return Neighbours(self.pairs, n_inside, n_pairs, self.block_ptr, self.p_ref, self.block_nearest2,
+                          self.block_shift2, self.closest, self.chunks)  # fmt: skip
 
 
 def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int) -> Records:
@@ -258,7 +258,7 @@ def simulate(
     gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
     initial = build(scenario)
     run = _run_of(scenario, initial, record)
-    law, params = law_of(scenario, gains, initial.state.shape[0])
+    law, params = law_of(scenario, gains)
     swarm = _in_slots(scenario, initial, gains, record)
     x = swarm.agents.state
     lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], np.stack([swarm.pairs.i, swarm.pairs.j], axis=1), run.use_lists)

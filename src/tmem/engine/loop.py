@@ -7,6 +7,15 @@ its own compiled copy with the model's step kernel bound to the name
 run time.  Each copy has a name of its own: Numba keys its on-disk cache by
 the function's name, not by ``parallel`` or by what a global name is bound
 to, and copies sharing a name would stand in for each other.
+
+Both loops are compiled without Numba's runtime (``_nrt=False``), so without
+reference counts.  Every record a stage receives, and every field read from
+it, would otherwise cost an atomic reference-count change per array, each
+step: 20 to 60 of them, which made a two-agent step take more than twice as
+long as its arithmetic.  It is safe because the caller keeps every array
+alive and nothing in a step allocates; a stage that allocated would not
+compile.  For the same reason no parallel loop reduces into a variable (Numba
+allocates for that): blocks write their partial results into work space.
 """
 
 from __future__ import annotations
@@ -54,7 +63,9 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
         known = measure(x, sensing)
         moved2 = corrected_positions(known, agents, law, run, neighbours)
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
-            neighbours.p_ref[:] = agents.corrected[:, :, 0]
+            for i in range(x.shape[0]):
+                for a in range(n_axes):
+                    neighbours.p_ref[i, a] = agents.corrected[i, a, 0]
             return LISTS_STALE
         neighbour_pushes(agents, neighbours, law, params, run)
         formation_pairs(k, agents, pairs, law, params, run, events, counters)
@@ -86,4 +97,4 @@ def advance_for(model_class, threaded: bool):
     namespace = dict(_advance_source.__globals__, vehicle_step=model_class.step)
     source = types.FunctionType(_advance_source.__code__, namespace, name)
     source.__qualname__ = name
-    return numba.njit(cache=True, parallel=threaded, error_model="numpy")(source)
+    return numba.njit(cache=True, parallel=threaded, error_model="numpy", _nrt=False)(source)

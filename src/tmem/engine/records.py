@@ -28,9 +28,9 @@ class Law(NamedTuple):
 
     Attributes
     ----------
-    gains : ndarray, shape (agents, 4)
+    gains : ndarray, shape (agents, 4) or (1, 4)
         Each agent's ``K = (K_P, K_V, K_phi, K_omega)``, in slot order; ``P* = x . K / K_P`` (6)
-        with the agent's own gains.  A scenario gives every agent the same row.
+        with the agent's own gains.  One row is every agent's: a scenario gives all agents the same.
     function : int
         Registry code of the scenario's function, used by the formation pairs.
     neighbour_function : int
@@ -152,6 +152,8 @@ class Neighbours(NamedTuple):
         ``P*`` when the lists were built.
     block_nearest2 : ndarray, shape (blocks,)
         Work space: each block's smallest squared distance this step.
+    block_shift2 : ndarray, shape (blocks,)
+        Work space: the largest squared shift of ``P*`` since ``p_ref`` in each block of agents this step.
     closest : ndarray, shape (1,)
         Smallest squared distance of two agents within reach so far.
     chunks : ndarray, shape (blocks + 1, 2 axes + 1, CHUNK)
@@ -164,6 +166,7 @@ class Neighbours(NamedTuple):
     block_ptr: np.ndarray
     p_ref: np.ndarray
     block_nearest2: np.ndarray
+    block_shift2: np.ndarray
     closest: np.ndarray
     chunks: np.ndarray
 

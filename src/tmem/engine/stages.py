@@ -103,7 +103,9 @@ def apply_commands(k, commands, agents, pairs, events, counters):
             agents.active[i] = kind == ADD
             rebuild = True  # the pairs listed are those of flying agents
             if kind == ADD:
-                agents.state[i] = agents.start[i]
+                for a in range(agents.state.shape[1]):
+                    for m in range(agents.state.shape[2]):
+                        agents.state[i, a, m] = agents.start[i, a, m]
             else:
                 agents.state[i, :, 1:] = 0.0
             log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind)
@@ -142,17 +144,26 @@ def corrected_positions(known, agents, law, run, neighbours):
     setpoint = agents.setpoint
     active = agents.active
     p_ref = neighbours.p_ref
+    block_shift2 = neighbours.block_shift2
+    n_agents = known.shape[0]
+    n_blocks = block_shift2.shape[0]
+    per_block = (n_agents + n_blocks - 1) // n_blocks
+    for b in numba.prange(n_blocks):  # each block's largest shift: a parallel reduction would allocate
+        block_shift2[b] = 0.0
+        for i in range(b * per_block, min(n_agents, (b + 1) * per_block)):
+            shift2 = 0.0
+            for a in range(n_axes):
+                corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains, i)
+                corrected[i, a, 1] = known[i, a, 0]
+                setpoint[i, a] = 0.0  # the sum of pushes starts here
+                if use_lists:
+                    delta = nearest_image(corrected[i, a, 0] - p_ref[i, a], box[a])
+                    shift2 += delta * delta
+            if active[i]:
+                block_shift2[b] = max(block_shift2[b], shift2)
     moved = 0.0
-    for i in numba.prange(known.shape[0]):
-        shift2 = 0.0
-        for a in range(n_axes):
-            corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains, i)
-            corrected[i, a, 1] = known[i, a, 0]
-            setpoint[i, a] = 0.0  # the sum of pushes starts here
-            if use_lists:
-                delta = nearest_image(corrected[i, a, 0] - p_ref[i, a], box[a])
-                shift2 += delta * delta
-        moved = max(moved, shift2 if active[i] else 0.0)
+    for b in range(n_blocks):
+        moved = max(moved, block_shift2[b])
     return moved
 
 
@@ -179,11 +190,15 @@ def _chunk_pushes(chunks, w, m, n_axes, function, params):
         chunks[w, 2 * n_axes, t] = dist2 if inside else np.inf
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, w):
     """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
     the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
-    the work space."""
+    the work space.
+
+    Called, not inlined: the loop calls it from two places, and each inlined copy of it (with the
+    interaction functions inside) cost two seconds of the first run's compilation.  The call costs
+    nanoseconds against the chunks of pairs it sums; the loop skips it when there are no pairs."""
     n_axes = len(box)
     nearest2 = np.inf
     for begin in range(first, stop, CHUNK):
@@ -232,11 +247,17 @@ def neighbour_pushes(agents, neighbours, law, params, run):
     chunks = neighbours.chunks
     n_blocks = block_ptr.shape[0] - 1
     for b in numba.prange(n_blocks):
-        block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params, setpoint,
-                                       chunks, b)  # fmt: skip
-    nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint,
-                          chunks, n_blocks)  # fmt: skip
-    neighbours.closest[0] = min(neighbours.closest[0], nearest2, block_nearest2.min())
+        block_nearest2[b] = np.inf
+        if block_ptr[b + 1] > block_ptr[b]:
+            block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params,
+                                           setpoint, chunks, b)  # fmt: skip
+    nearest2 = np.inf
+    if neighbours.n_pairs > neighbours.n_inside:
+        nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint,
+                              chunks, n_blocks)  # fmt: skip
+    for b in range(n_blocks):
+        nearest2 = min(nearest2, block_nearest2[b])
+    neighbours.closest[0] = min(neighbours.closest[0], nearest2)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -365,7 +386,9 @@ def record(agents, pairs, records, c_max, run, counters):
     q_record = counters.next_record[0]
     for q in range(records.slots.shape[0]):
         i = records.slots[q]
-        records.state[q_record, q] = agents.state[i]
+        for a in range(n_axes):
+            for m in range(agents.state.shape[2]):
+                records.state[q_record, q, a, m] = agents.state[i, a, m]
         records.active[q_record, q] = agents.active[i]
         scale = tilt_scale(agents.setpoint, i, n_axes, c_max) if agents.active[i] else 0.0
         for a in range(n_axes):
