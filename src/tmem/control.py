@@ -177,3 +177,24 @@ def corrected_position(p, v, phi, omega, gains, agent):
     """
     row = agent if gains.shape[0] > 1 else 0  # one row shared: no stream of identical rows through the cache
     return (p * gains[row, 0] + v * gains[row, 1] + phi * gains[row, 2] + omega * gains[row, 3]) / gains[row, 0]
+
+
+@numba.njit(cache=True, inline="always")
+def tilt_scale(u, i, n_axes, c_max):
+    """The factor that saturates agent ``i``'s summed set-point on its norm, ``|U| <= c_max``.
+
+    Parameters
+    ----------
+    u : ndarray, shape (agents, axes)
+        Summed set-points (rad).
+    i : int
+        The agent's slot.
+    n_axes : int
+        Number of axes.
+    c_max : float
+        Tilt limit (rad).
+    """
+    norm2 = 0.0
+    for a in range(n_axes):
+        norm2 += u[i, a] * u[i, a]
+    return c_max / np.sqrt(norm2) if norm2 > c_max * c_max else 1.0

@@ -30,7 +30,8 @@ from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any
 from ..space import into_box
 from ..sensing import measure
 from .records import DONE, LISTS_STALE
-from .stages import apply_commands, commands_due, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record, tilt_scale
+from ..control import tilt_scale
+from .stages import apply_commands, commands_due, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record
 
 
 def vehicle_step(x, u, i, scale, params, n_axes):

@@ -12,7 +12,7 @@ work space comes in the records.
 4. :func:`neighbour_pushes` — the pushes of the non-formation neighbours;
 5. :func:`formation_pairs` — each pair's flag ``F_en`` and its pull or push;
 6. :func:`record` — the recorded step;
-7. combining and saturating the set-point (:func:`tilt_scale`) and the
+7. combining and saturating the set-point (:func:`tmem.control.tilt_scale`) and the
    vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
 
 Steps 5 and 6 of the agents' update share one pass: the factor that saturates
@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
-from ..control import corrected_position
+from ..control import corrected_position, tilt_scale
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
 from .records import ADD, COUPLE, REMOVE
@@ -334,27 +334,6 @@ def formation_pairs(k, agents, pairs, law, params, run, events, counters):
             pairs.flag[e] = new
             log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1)
         _pair_pull(e, d, r, pairs, law, params, len(run.box), agents.setpoint)
-
-
-@numba.njit(cache=True, inline="always")
-def tilt_scale(u, i, n_axes, c_max):
-    """The factor that saturates agent ``i``'s summed set-point on its norm, ``|U| <= c_max``.
-
-    Parameters
-    ----------
-    u : ndarray, shape (agents, axes)
-        Summed set-points (rad).
-    i : int
-        The agent's slot.
-    n_axes : int
-        Number of axes.
-    c_max : float
-        Tilt limit (rad).
-    """
-    norm2 = 0.0
-    for a in range(n_axes):
-        norm2 += u[i, a] * u[i, a]
-    return c_max / np.sqrt(norm2) if norm2 > c_max * c_max else 1.0
 
 
 @numba.njit(cache=True, inline="always")

@@ -128,7 +128,7 @@ def step_zero_order_hold(x, u, i, scale, params, n_axes):
     i : int
         The agent.
     scale : float
-        Saturation factor of ``u[i]`` (:func:`tmem.engine.stages.tilt_scale`).
+        Saturation factor of ``u[i]`` (:func:`tmem.control.tilt_scale`).
     params : HoldStep
         ``(Ad, Bd)`` for the time step.
     n_axes : int
