@@ -164,6 +164,8 @@ def unsupported(scenario: Scenario) -> str | None:
         return "at most one command, an uncouple"
     if any(a.tilt != 0 or a.tilt_rate != 0 or not a.active for a in scenario.agents):
         return "the agents must start level (tilt and tilt rate zero) and flying"
+    if scenario.interaction.uncouple_when != "window" or scenario.interaction.synchronise:
+        return "the batch uncouples by the window (9) and does not synchronise"
     return None
 
 
@@ -220,7 +222,8 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
     hold = model.step_params(sim.dt)
-    law, params = law_of(scenario, gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r))
+    linearisation = model.linearisation()
+    law, params = law_of(scenario, linearisation, gains_for(*linearisation, c.r_l, c.im_l, c.im_r))
     cases = len(positions)
     start = np.zeros((cases, 2, 4))
     start[:, :, 0] = positions

@@ -27,6 +27,29 @@ Where the flag flips is a reading of the paper (``interaction.switch_at``):
 
 (9)'s second line, ``d_t < R + R_j``, is a property of the scenario and is
 checked when it is validated.
+
+**Energy-matched uncoupling** (``interaction.uncouple_when = "energy"``), the
+paper's own rule (Section III.C, after (9)): "uncoupling must occur at the
+moment when the kinetic energy of the agent and the difference between the
+values of functions f1(c_j) and f2(c_j) will be equal to those that were at
+the moment of coupling".  Read here as:
+
+* the kinetic energy is that of the pair's relative motion along ``d``,
+  ``E = ((V_j - V_i) . d / |d|)^2 / 4`` per unit mass of one agent (the
+  reduced mass is half an agent's).  The pushes act along ``d``, equal and
+  opposite: the pair's common motion and its motion across ``d`` pass through
+  the encounter unchanged, so only ``E`` is exchanged with the functions;
+* at coupling the pair records ``E_c`` and ``Delta_c = f1(|d|) - f2(|d|)``;
+* after the uncouple command it lets go at the first step over which
+  ``f1 - f2`` passes ``Delta_c`` (steps are discrete: a value is passed, not
+  hit; where ``f1 - f2`` is flat, as (10)'s between its saturations, every
+  step matches) with ``|E - E_c| <= energy_tolerance E_c``;
+* if that has not happened one period of the coupled pair's slow mode after
+  the command (:func:`tmem.synchronise.coupled_mode`: in that time the pair's
+  oscillation passes every point of its orbit), the window rule (9) applies
+  from then on, and the event names the fallback.
+
+Events name the rule that released each pair (:data:`RELEASES`).
 """
 
 from __future__ import annotations
@@ -34,12 +57,20 @@ from __future__ import annotations
 import numba
 
 from . import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from .interaction.kernels import pair_control
 
 #: Command actions, in the order of their integer codes.
 ACTIONS = ("uncouple", "couple")
 #: Event kinds, in the order of their integer codes.
 EVENT_KINDS = ("command", "couple", "uncouple")
 EVENT_COMMAND, EVENT_COUPLE, EVENT_UNCOUPLE = range(3)
+#: ``interaction.uncouple_when``, in the order of their integer codes.
+UNCOUPLE_RULES = ("window", "energy")
+UNCOUPLE_BY_WINDOW, UNCOUPLE_BY_ENERGY = range(2)
+#: What released a pair (an ``uncouple`` event's rule), in the order of their integer codes: (9),
+#: the energy match, (9) after the energy match was not found in time, the loss of an agent.
+RELEASES = ("window", "energy", "fallback", "lost")
+RELEASE_WINDOW, RELEASE_ENERGY, RELEASE_FALLBACK, RELEASE_LOST = range(4)
 
 
 @numba.njit(cache=True)
@@ -73,3 +104,62 @@ def next_flag(f_en, armed, r_before, r, d_t, eps, at_crossing):
         if f_en == 1 and not armed:
             return 0
     return f_en
+
+
+@numba.njit(cache=True, inline="always")
+def function_gap(function, r, p):
+    """``f1(|d|) - f2(|d|)``: the function with ``F_en = 0`` less the one with ``F_en = 1``.
+
+    Parameters
+    ----------
+    function : int
+        Registry code of the function ((10) or (11)).
+    r : float
+        ``|d|`` (m).
+    p : FunctionParams
+        The functions' parameters, with the pair's ``d_t``.
+    """
+    return pair_control(function, r, 0, p) - pair_control(function, r, 1, p)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def relative_energy(known, i, j, d, r, n_axes):
+    """``E = ((V_j - V_i) . d / |d|)^2 / 4``: the kinetic energy of the pair's motion along ``d``,
+    per unit mass of one agent.
+
+    Parameters
+    ----------
+    known : ndarray, shape (agents, axes, n_state)
+        The states as measured; the velocity is component 1.
+    i, j : int
+        The pair's agents.
+    d : ndarray, shape (axes,)
+        ``P*_j - P*_i``.
+    r : float
+        ``|d|`` (m), > 0.
+    n_axes : int
+    """
+    along = 0.0
+    for a in range(n_axes):
+        along += (known[j, a, 1] - known[i, a, 1]) * d[a]
+    along /= r
+    return 0.25 * along * along
+
+
+@numba.njit(cache=True, inline="always")
+def energy_matched(gap_before, gap, gap_c, energy, energy_c, tolerance):
+    """Whether a step matched the values at coupling (see the module text).
+
+    Parameters
+    ----------
+    gap_before, gap : float
+        ``f1 - f2`` before and after the step (NaN before the first step: no match).
+    gap_c : float
+        ``f1 - f2`` at coupling.
+    energy, energy_c : float
+        The relative kinetic energy now and at coupling (:func:`relative_energy`).
+    tolerance : float
+        The relative tolerance on the energy.
+    """
+    passed = (gap_before - gap_c) * (gap - gap_c) <= 0.0
+    return passed and abs(energy - energy_c) <= tolerance * energy_c

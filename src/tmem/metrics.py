@@ -156,7 +156,10 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
     largest angle between a pair's direction ``P_j - P_i`` and the direction it
     must hold (pairs that hold one); ``formed_at``: when the last pair coupled,
     if all did (0 if they started coupled); ``coupled_at_end``: the share of
-    pairs coupled at the end.
+    pairs coupled at the end; ``settling_time``: the first recorded time from
+    which every coupled pair stays within :data:`SETTLE_BAND` of its ``d_t`` to
+    the end (``None`` if they are not within it at the end); ``residual_error``:
+    the largest ``|distance - d_t|`` of a coupled pair at the end.
 
     Parameters
     ----------
@@ -185,9 +188,34 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
         np.ptp(trajectory.pair_distance[flag[:, p], p]) / 2 for p in range(len(trajectory.pairs)) if flag[:, p].any()
     ]
     result["amplitude_max"] = float(max(amplitudes)) if amplitudes else None
+    result.update(settling(trajectory))
     if scenario.formation.bearing:
         result["direction_error_deg"] = direction_error_deg(trajectory)
     return result
+
+
+#: A formation has settled when every coupled pair's distance stays within this of its ``d_t`` (m).
+SETTLE_BAND = 0.1
+
+
+def settling(trajectory: Trajectory, band: float = SETTLE_BAND) -> dict:
+    """``settling_time`` and ``residual_error`` of a formation's coupled pairs (see :func:`formation_summary`).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`).
+    band : float
+        The band around ``d_t`` (m).
+    """
+    coupled = trajectory.flag == 1
+    error = np.where(coupled, np.abs(trajectory.pair_distance - trajectory.d_t), 0.0)
+    outside = np.flatnonzero((error > band).any(axis=1))
+    settled = not outside.size or outside[-1] < len(trajectory.time) - 1
+    return {
+        "settling_time": (float(trajectory.time[outside[-1] + 1]) if outside.size else 0.0) if settled else None,
+        "residual_error": float(error[-1].max()) if coupled[-1].any() else None,
+    }
 
 
 def direction_error_deg(trajectory: Trajectory) -> float | None:
@@ -228,6 +256,8 @@ def summarize_events(events: list[Event]) -> list[dict]:
         row = {"time": e.time, "kind": e.kind, "agents": list(e.agents)}
         if e.action is not None:
             row["action"] = e.action
+        if e.rule is not None:
+            row["rule"] = e.rule
         rows.append(row)
     return rows
 

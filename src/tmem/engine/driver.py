@@ -27,6 +27,7 @@ from ..model import vehicle_model
 from ..neighbors import all_pairs, arrange, spatial_order, verlet_pairs
 from ..scenario import Scenario
 from ..sensing import Sensing, exact
+from ..synchronise import coupled_mode, synchronising_gain
 from .loop import advance_for
 from .stages import CHUNK
 from .records import (
@@ -61,13 +62,16 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
     return steps
 
 
-def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
+def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gains: np.ndarray) -> tuple[Law, FunctionParams]:
     """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters.
 
     Parameters
     ----------
     scenario : Scenario
         The scenario whose ``[interaction]`` table sets the law.
+    linearisation : (ndarray, ndarray)
+        The vehicle's ``(A, B)`` on ``(P, V, phi, omega)``: the coupled pair's loop (S1) sets the
+        synchronising gain and the energy rule's fallback time.
     gains : ndarray, shape (4,)
         ``K`` placing the roots (5) (:func:`tmem.control.gains_for`), every agent's: the law holds it
         as one row that all agents share.
@@ -79,6 +83,9 @@ def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
     """
     ia = scenario.interaction
     couples = uses_coupling(ia.function)
+    sync_gain = synchronising_gain(*linearisation, gains, ia.sync_damping) if ia.synchronise else 0.0
+    slow = coupled_mode(*linearisation, gains, sync_gain)
+    period = 2.0 * np.pi / abs(slow.imag) if slow.imag != 0.0 else 1.0 / abs(slow.real)
     law = Law(
         gains=gains[np.newaxis, :],
         function=code(ia.function),
@@ -86,6 +93,10 @@ def law_of(scenario: Scenario, gains: np.ndarray) -> tuple[Law, FunctionParams]:
         couples=couples,
         at_crossing=ia.switch_at == "crossing",
         eps=ia.eps,
+        uncouple_rule=coupling.UNCOUPLE_RULES.index(ia.uncouple_when),
+        energy_tolerance=ia.energy_tolerance,
+        fallback_steps=scenario.simulation.step_of(period),
+        sync_gain=sync_gain,
     )
     return law, FunctionParams(gains[0], ia.reach, ia.d_t, ia.c_max)
 
@@ -175,7 +186,8 @@ def _read_events(events: Events, n_events: int, order: np.ndarray, dt: float) ->
         kind = coupling.EVENT_KINDS[events.kind[e]]
         agents = tuple(int(order[v]) for v in (events.i[e], events.j[e]) if v >= 0)
         action = COMMANDS[events.action[e]] if kind == "command" else None
-        found.append(Event(time=round(float(events.step[e] * dt), 12), kind=kind, agents=agents, action=action))
+        rule = coupling.RELEASES[events.rule[e]] if events.rule[e] >= 0 else None
+        found.append(Event(time=round(float(events.step[e] * dt), 12), kind=kind, agents=agents, action=action, rule=rule))
     return found
 
 
@@ -210,6 +222,7 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     n_edges = len(edges)
     pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
                   np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf),
+                  np.full(n_edges, np.nan), np.full(n_edges, np.nan), np.zeros(n_edges, dtype=np.int64),
                   np.empty(n_axes))  # fmt: skip
     commands = _commands(scenario, edges, slot)
     steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
@@ -258,7 +271,7 @@ def simulate(
     gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
     initial = build(scenario)
     run = _run_of(scenario, initial, record)
-    law, params = law_of(scenario, gains)
+    law, params = law_of(scenario, model.linearisation(), gains)
     swarm = _in_slots(scenario, initial, gains, record)
     x = swarm.agents.state
     lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], np.stack([swarm.pairs.i, swarm.pairs.j], axis=1), run.use_lists)

@@ -31,7 +31,8 @@ from ..space import into_box
 from ..sensing import measure
 from .records import DONE, LISTS_STALE
 from ..control import tilt_scale
-from .stages import apply_commands, commands_due, corrected_positions, formation_pairs, is_recorded, neighbour_pushes, record
+from .pairs import formation_pairs
+from .stages import apply_commands, commands_due, corrected_positions, is_recorded, neighbour_pushes, record
 
 
 def vehicle_step(x, u, i, scale, params, n_axes):
@@ -69,7 +70,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
                     neighbours.p_ref[i, a] = agents.corrected[i, a, 0]
             return LISTS_STALE
         neighbour_pushes(agents, neighbours, law, params, run)
-        formation_pairs(k, agents, pairs, law, params, run, events, counters)
+        formation_pairs(k, known, agents, pairs, law, params, run, events, counters)
         if is_recorded(k, run):
             record(agents, pairs, records, c_max, run, counters)
         if k < run.n_steps:

@@ -42,6 +42,14 @@ class Law(NamedTuple):
         ``interaction.switch_at == "crossing"`` (:func:`tmem.coupling.next_flag`).
     eps : float
         The coupling window of (9) (m).
+    uncouple_rule : int
+        Code of ``interaction.uncouple_when`` (:data:`tmem.coupling.UNCOUPLE_RULES`).
+    energy_tolerance : float
+        The relative tolerance of the energy-matched uncoupling.
+    fallback_steps : int
+        Steps after an uncouple command when the energy-matched uncoupling falls back on (9).
+    sync_gain : float
+        ``k_s`` of the speed synchronisation (S2) (rad per m/s); 0: none.
 
     The interaction functions' parameters travel beside it, as their own
     record (:class:`~tmem.interaction.kernels.FunctionParams`: the law's ``K_P``,
@@ -55,6 +63,10 @@ class Law(NamedTuple):
     couples: bool
     at_crossing: bool
     eps: float
+    uncouple_rule: int
+    energy_tolerance: float
+    fallback_steps: int
+    sync_gain: float
 
 
 class Run(NamedTuple):
@@ -122,6 +134,11 @@ class Pairs(NamedTuple):
         ``|d|`` one step earlier (NaN before the first step).
     min_distance : ndarray, shape (pairs,)
         Smallest ``|P_j - P_i|`` so far.
+    coupled_gap, coupled_energy : ndarray, shape (pairs,)
+        ``f1 - f2`` and the relative kinetic energy at the pair's last coupling
+        (:mod:`tmem.coupling`; NaN before it).
+    disarmed_at : ndarray, shape (pairs,), int
+        The step of the last uncouple command to the pair.
     d : ndarray, shape (axes,)
         Work space: one pair's ``d = P*_j - P*_i``.  The loop allocates nothing at each step;
         at two agents an allocation per step costs as much as the step itself.
@@ -135,6 +152,9 @@ class Pairs(NamedTuple):
     armed: np.ndarray
     r_before: np.ndarray
     min_distance: np.ndarray
+    coupled_gap: np.ndarray
+    coupled_energy: np.ndarray
+    disarmed_at: np.ndarray
     d: np.ndarray
 
 
@@ -197,13 +217,15 @@ class Records(NamedTuple):
 
 
 class Events(NamedTuple):
-    """Coupling transitions and commands, as they happen: step, kind, agents (slots; -1: none), action."""
+    """Coupling transitions and commands, as they happen: step, kind, agents (slots; -1: none), action,
+    and the rule that released a pair (:data:`tmem.coupling.RELEASES`; -1: none)."""
 
     step: np.ndarray
     kind: np.ndarray
     i: np.ndarray
     j: np.ndarray
     action: np.ndarray
+    rule: np.ndarray
 
 
 class Counters(NamedTuple):

@@ -10,7 +10,7 @@ work space comes in the records.
 3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
    lists have drifted;
 4. :func:`neighbour_pushes` — the pushes of the non-formation neighbours;
-5. :func:`formation_pairs` — each pair's flag ``F_en`` and its pull or push;
+5. :func:`tmem.engine.pairs.formation_pairs` — each pair's flag ``F_en`` and its pull or push;
 6. :func:`record` — the recorded step;
 7. combining and saturating the set-point (:func:`tmem.control.tilt_scale`) and the
    vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
@@ -29,15 +29,15 @@ from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale 
 from ..control import corrected_position, tilt_scale
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
-from .records import ADD, COUPLE, REMOVE
+from .records import ADD, COUPLE, REMOVE, UNCOUPLE
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
 CHUNK = 256
 
 
 @numba.njit(cache=True, inline="always")
-def log_event(events, counters, k, kind, i, j, action):
-    """Append an event at step ``k`` (agents as slots, -1 for none; action -1 for none).
+def log_event(events, counters, k, kind, i, j, action, rule):
+    """Append an event at step ``k`` (agents as slots, -1 for none; action and rule -1 for none).
 
     Parameters
     ----------
@@ -51,6 +51,8 @@ def log_event(events, counters, k, kind, i, j, action):
         Slots of the agents, -1 for none.
     action : int
         Command code (:data:`tmem.engine.records.COMMANDS`), -1 for none.
+    rule : int
+        What released a pair (:data:`tmem.coupling.RELEASES`), -1 for none.
     """
     n = counters.n_events[0]
     events.step[n] = k
@@ -58,6 +60,7 @@ def log_event(events, counters, k, kind, i, j, action):
     events.i[n] = i
     events.j[n] = j
     events.action[n] = action
+    events.rule[n] = rule
     counters.n_events[0] = n + 1
 
 
@@ -108,16 +111,18 @@ def apply_commands(k, commands, agents, pairs, events, counters):
                         agents.state[i, a, m] = agents.start[i, a, m]
             else:
                 agents.state[i, :, 1:] = 0.0
-            log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind)
+            log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind, -1)
         else:
-            if first == commands.ptr[c + 1]:
-                pairs.armed[:] = 1 if kind == COUPLE else 0
-            for t in range(first, commands.ptr[c + 1]):
-                pairs.armed[commands.target[t]] = 1 if kind == COUPLE else 0
+            every = first == commands.ptr[c + 1]
+            for t in range(pairs.armed.shape[0] if every else commands.ptr[c + 1] - first):
+                e = t if every else commands.target[first + t]
+                pairs.armed[e] = 1 if kind == COUPLE else 0
+                if kind == UNCOUPLE:
+                    pairs.disarmed_at[e] = k  # the energy rule's fallback counts from here
             single = commands.ptr[c + 1] - first == 1
             i = pairs.i[commands.target[first]] if single else -1
             j = pairs.j[commands.target[first]] if single else -1
-            log_event(events, counters, k, coupling.EVENT_COMMAND, i, j, kind)
+            log_event(events, counters, k, coupling.EVENT_COMMAND, i, j, kind, -1)
         counters.next_command[0] = c + 1
     return rebuild
 
@@ -258,82 +263,6 @@ def neighbour_pushes(agents, neighbours, law, params, run):
     for b in range(n_blocks):
         nearest2 = min(nearest2, block_nearest2[b])
     neighbours.closest[0] = min(neighbours.closest[0], nearest2)
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _pair_geometry(corrected, e, pairs, box, d):
-    """``d = P*_j - P*_i`` of pair ``e`` into ``d``; return ``(|d|, |P_j - P_i|)`` (nearest images)."""
-    i = pairs.i[e]
-    j = pairs.j[e]
-    r2 = 0.0
-    dist2 = 0.0
-    for a in range(len(box)):
-        d[a] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
-        r2 += d[a] * d[a]
-        delta = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
-        dist2 += delta * delta
-    return np.sqrt(r2), np.sqrt(dist2)
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
-    """Add pair ``e``'s push to its agents, equal and opposite: (10)/(11) along ``d / |d|``, or, while
-    coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)`` saturated on its norm."""
-    i = pairs.i[e]
-    j = pairs.j[e]
-    if pairs.flag[e] == 1 and not np.isnan(pairs.direction[e, 0]):
-        norm2 = 0.0
-        for a in range(n_axes):
-            d[a] = params.k_p * (d[a] - pairs.direction[e, a] * pairs.d_t[e])
-            norm2 += d[a] * d[a]
-        scale = min(1.0, params.c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
-        for a in range(n_axes):
-            u[i, a] += scale * d[a]
-            u[j, a] -= scale * d[a]
-    elif r > 0.0:
-        p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
-        push = pair_control(law.function, r, pairs.flag[e], p) / r
-        for a in range(n_axes):
-            u[i, a] += push * d[a]
-            u[j, a] -= push * d[a]
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def formation_pairs(k, agents, pairs, law, params, run, events, counters):
-    """Each formation pair: its flag ``F_en`` after this step's check (:func:`tmem.coupling.next_flag`,
-    (9)), its smallest distance, and its pull or push on both agents.  A pair whose agent was removed
-    uncouples and rests.
-
-    Parameters
-    ----------
-    k : int
-        The step.
-    agents, pairs, law, run, events, counters
-        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
-    params : FunctionParams
-        The interaction functions' parameters; each pair's own ``d_t`` replaces the scenario's.
-    """
-    d = pairs.d
-    for e in range(pairs.i.shape[0]):
-        i = pairs.i[e]
-        j = pairs.j[e]
-        if not (agents.active[i] and agents.active[j]):
-            if pairs.flag[e] == 1:  # the pair is lost with its agent
-                pairs.flag[e] = 0
-                log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1)
-            pairs.r_before[e] = np.nan
-            continue
-        r, dist = _pair_geometry(agents.corrected, e, pairs, run.box, d)
-        if dist < pairs.min_distance[e]:
-            pairs.min_distance[e] = dist
-        new = pairs.flag[e]
-        if law.couples:
-            new = coupling.next_flag(pairs.flag[e], pairs.armed[e], pairs.r_before[e], r, pairs.d_t[e], law.eps, law.at_crossing)
-        pairs.r_before[e] = r
-        if new != pairs.flag[e]:
-            pairs.flag[e] = new
-            log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1)
-        _pair_pull(e, d, r, pairs, law, params, len(run.box), agents.setpoint)
 
 
 @numba.njit(cache=True, inline="always")

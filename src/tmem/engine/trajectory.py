@@ -26,6 +26,7 @@ class Event:
     kind: str  # "command" | "couple" | "uncouple"
     agents: tuple[int, ...]
     action: str | None = None  # for commands: "couple" | "uncouple" | "remove" | "add"
+    rule: str | None = None  # for uncouple events: what released the pair (tmem.coupling.RELEASES)
 
 
 @dataclass(frozen=True)

@@ -112,7 +112,16 @@ class ControllerParams(StrictModel):
 
 
 class InteractionParams(StrictModel):
-    """Interaction function and its parameters, (7)-(11)."""
+    """Interaction function and its parameters, (7)-(11), and how coupled pairs behave.
+
+    ``uncouple_when``: after an uncouple command, a pair lets go at the first
+    moment (9) holds (``"window"``), or where its relative kinetic energy and
+    ``f1 - f2`` match their values at coupling, within ``energy_tolerance``
+    (``"energy"``, :mod:`tmem.coupling`).  ``synchronise``: a coupled pair
+    damps its relative motion (its slow mode's damping ratio
+    ``sync_damping``) and puts the energy into its common motion
+    (:mod:`tmem.synchronise`).
+    """
 
     function: Literal[FUNCTION_NAMES] = "improved"
     radius: Positive = 20.0
@@ -120,6 +129,10 @@ class InteractionParams(StrictModel):
     d_t: Positive = 35.0
     eps: Positive = 0.2
     switch_at: Literal["window", "crossing"] = "window"
+    uncouple_when: Literal["window", "energy"] = "window"
+    energy_tolerance: Annotated[float, Field(gt=0, lt=1)] = 0.05
+    synchronise: bool = False
+    sync_damping: Annotated[float, Field(gt=0, lt=1)] = 0.7
 
     @property
     def reach(self) -> float:

@@ -1,0 +1,126 @@
+"""The formation pairs' stage: each pair's flag ``F_en`` (9), its pull or push (10)/(11), its synchronisation.
+
+A pair couples and uncouples by :mod:`tmem.coupling`: at the window (9), and,
+with ``interaction.uncouple_when = "energy"``, uncouples where its relative
+kinetic energy and ``f1 - f2`` match their values at coupling.  While coupled
+it may also synchronise its agents' speeds (:mod:`tmem.synchronise`, (S2)).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from .. import coupling
+from ..interaction.kernels import FunctionParams, pair_control
+from ..space import nearest_image
+from ..synchronise import synchronising_push
+from .stages import log_event
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _pair_geometry(corrected, e, pairs, box, d):
+    """``d = P*_j - P*_i`` of pair ``e`` into ``d``; return ``(|d|, |P_j - P_i|)`` (nearest images)."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    r2 = 0.0
+    dist2 = 0.0
+    for a in range(len(box)):
+        d[a] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
+        r2 += d[a] * d[a]
+        delta = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
+        dist2 += delta * delta
+    return np.sqrt(r2), np.sqrt(dist2)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _next_flag(k, e, r, energy, pairs, law, params):
+    """Pair ``e``'s flag after step ``k``'s check, and the rule that released it (-1: none).
+
+    At coupling the pair records ``f1 - f2`` and its relative kinetic energy ``energy``
+    (a pair that starts coupled records them at its first step); a disarmed, coupled pair lets go
+    by (9), or by the energy match with its fallback on (9) (:mod:`tmem.coupling`).
+    """
+    flag = pairs.flag[e]
+    p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
+    window = coupling.next_flag(flag, pairs.armed[e], pairs.r_before[e], r, pairs.d_t[e], law.eps, law.at_crossing)
+    if flag == 1 and np.isnan(pairs.coupled_energy[e]) or flag == 0 and window == 1:
+        pairs.coupled_gap[e] = coupling.function_gap(law.function, r, p)
+        pairs.coupled_energy[e] = energy
+    if flag == 0 or pairs.armed[e]:
+        return window, -1
+    if law.uncouple_rule == coupling.UNCOUPLE_BY_WINDOW:
+        return window, coupling.RELEASE_WINDOW if window == 0 else -1
+    gap_before = coupling.function_gap(law.function, pairs.r_before[e], p)
+    gap = coupling.function_gap(law.function, r, p)
+    if coupling.energy_matched(gap_before, gap, pairs.coupled_gap[e], energy, pairs.coupled_energy[e], law.energy_tolerance):
+        return 0, coupling.RELEASE_ENERGY
+    if window == 0 and k - pairs.disarmed_at[e] >= law.fallback_steps:
+        return 0, coupling.RELEASE_FALLBACK
+    return 1, -1
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
+    """Add pair ``e``'s push to its agents, equal and opposite: (10)/(11) along ``d / |d|``, or, while
+    coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)`` saturated on its norm."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if pairs.flag[e] == 1 and not np.isnan(pairs.direction[e, 0]):
+        norm2 = 0.0
+        for a in range(n_axes):
+            d[a] = params.k_p * (d[a] - pairs.direction[e, a] * pairs.d_t[e])
+            norm2 += d[a] * d[a]
+        scale = min(1.0, params.c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
+        for a in range(n_axes):
+            u[i, a] += scale * d[a]
+            u[j, a] -= scale * d[a]
+    elif r > 0.0:
+        p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
+        push = pair_control(law.function, r, pairs.flag[e], p) / r
+        for a in range(n_axes):
+            u[i, a] += push * d[a]
+            u[j, a] -= push * d[a]
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def formation_pairs(k, known, agents, pairs, law, params, run, events, counters):
+    """Each formation pair: its flag ``F_en`` after this step's check ((9), or the energy match), its
+    smallest distance, its pull or push on both agents, and, while coupled, the synchronisation (S2).
+    A pair whose agent was removed uncouples and rests.
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    known : ndarray, shape (agents, axes, n_state)
+        The states as measured (:func:`tmem.sensing.measure`): the pair's relative velocity.
+    agents, pairs, law, run, events, counters
+        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters; each pair's own ``d_t`` replaces the scenario's.
+    """
+    d = pairs.d
+    n_axes = len(run.box)
+    for e in range(pairs.i.shape[0]):
+        i = pairs.i[e]
+        j = pairs.j[e]
+        if not (agents.active[i] and agents.active[j]):
+            if pairs.flag[e] == 1:  # the pair is lost with its agent
+                pairs.flag[e] = 0
+                log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1, coupling.RELEASE_LOST)
+            pairs.r_before[e] = np.nan
+            continue
+        r, dist = _pair_geometry(agents.corrected, e, pairs, run.box, d)
+        if dist < pairs.min_distance[e]:
+            pairs.min_distance[e] = dist
+        if law.couples:
+            energy = coupling.relative_energy(known, i, j, d, r, n_axes) if r > 0.0 else 0.0
+            new, released_by = _next_flag(k, e, r, energy, pairs, law, params)
+            if new != pairs.flag[e]:
+                pairs.flag[e] = new
+                log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1, released_by)
+        pairs.r_before[e] = r
+        _pair_pull(e, d, r, pairs, law, params, n_axes, agents.setpoint)
+        if pairs.flag[e] == 1 and law.sync_gain > 0.0:
+            synchronising_push(known, i, j, law.sync_gain, params.c_max, n_axes, agents.setpoint)
