@@ -1,6 +1,6 @@
 """Speed of the paper reproduction: prints figures and writes them as JSON.
 
-Two measurements (issue "Reproduce the TMEM formation paper", item 12):
+Two measurements of `tmem paper`:
 
 1. The 60 s two-agent scenario (Table 2, improved switching (11)) at
    dt = 1 ms, 60 000 steps: wall time of ``tmem.simulate`` after warm-up,
