@@ -37,19 +37,20 @@ def _pair_geometry(corrected, e, pairs, box, d):
 def _next_flag(k, e, r, energy, pairs, law, params):
     """Pair ``e``'s flag after step ``k``'s check, and the rule that released it (-1: none).
 
-    At coupling the pair records ``f1 - f2`` and its relative kinetic energy ``energy``
-    (a pair that starts coupled records them at its first step); a disarmed, coupled pair lets go
+    Under the energy rule, at coupling the pair records ``f1 - f2`` and its relative kinetic energy
+    ``energy`` (a pair that starts coupled records them at its first step); a disarmed, coupled pair lets go
     by (9), or by the energy match with its fallback on (9) (:mod:`tmem.coupling`).
     """
     flag = pairs.flag[e]
     p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
     window = coupling.next_flag(flag, pairs.armed[e], pairs.r_before[e], r, pairs.d_t[e], law.eps, law.at_crossing)
-    if flag == 1 and np.isnan(pairs.coupled_energy[e]) or flag == 0 and window == 1:
+    energy_rule = law.uncouple_rule == coupling.UNCOUPLE_BY_ENERGY
+    if energy_rule and (flag == 1 and np.isnan(pairs.coupled_energy[e]) or flag == 0 and window == 1):
         pairs.coupled_gap[e] = coupling.function_gap(law.function, r, p)
         pairs.coupled_energy[e] = energy
     if flag == 0 or pairs.armed[e]:
         return window, -1
-    if law.uncouple_rule == coupling.UNCOUPLE_BY_WINDOW:
+    if not energy_rule:
         return window, coupling.RELEASE_WINDOW if window == 0 else -1
     gap_before = coupling.function_gap(law.function, pairs.r_before[e], p)
     gap = coupling.function_gap(law.function, r, p)
@@ -115,7 +116,9 @@ def formation_pairs(k, known, agents, pairs, law, params, run, events, counters)
         if dist < pairs.min_distance[e]:
             pairs.min_distance[e] = dist
         if law.couples:
-            energy = coupling.relative_energy(known, i, j, d, r, n_axes) if r > 0.0 else 0.0
+            energy = 0.0  # needed by the energy rule only
+            if law.uncouple_rule == coupling.UNCOUPLE_BY_ENERGY and r > 0.0:
+                energy = coupling.relative_energy(known, i, j, d, r, n_axes)
             new, released_by = _next_flag(k, e, r, energy, pairs, law, params)
             if new != pairs.flag[e]:
                 pairs.flag[e] = new
