@@ -103,11 +103,12 @@ def test_rerun_replaces_an_earlier_run(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["o"]  # no temporary directory left behind
 
 
-def test_paper_command_writes_three_runs_and_the_report(tmp_path):
+def test_paper_command_writes_the_runs_and_the_report(tmp_path):
     out = tmp_path / "paper"
     result = CliRunner().invoke(app, ["paper", "--out", str(out)])
     assert result.exit_code == 0, result.output
-    assert sorted(p.name for p in out.iterdir()) == [".tmem-output.json", "fig5", "fig7", "fig9", "report.md"]
+    further = ["fig7-energy", "fig7-sync", "fig9-energy", "fig9-sync"]
+    assert sorted(p.name for p in out.iterdir()) == sorted([".tmem-output.json", "fig5", "fig7", "fig9", *further, "report.md"])
     report = (out / "report.md").read_text()
     for name in ("fig5", "fig7", "fig9"):
         s = json.loads((out / name / "summary.json").read_text())
@@ -117,4 +118,10 @@ def test_paper_command_writes_three_runs_and_the_report(tmp_path):
             assert f"{s['rms_change_percent']:+.2f} %" in report
             assert f"F_en drops at {s['uncouple_time']:.2f} s" in report
     assert "≈ 5.6 %" in report and "≈ 0.2 %" in report
+    for name in further:  # the further work's reruns, each quoted in its own row
+        s = json.loads((out / name / "summary.json").read_text())
+        (row,) = [line for line in report.splitlines() if line.startswith(f"| {name} |")]
+        assert f"{s['rms_change_percent']:+.3f} %" in row
+        released = [e for e in s["events"] if e["kind"] == "uncouple"][0]
+        assert f"{released['time']:.2f} s, {released['rule']}" in row
 

@@ -91,21 +91,47 @@ def test_a_synchronised_pair_decays_at_the_rate_of_its_slow_root():
     assert np.abs(unsynchronised[-300:]).max() > 0.3  # without it the pair keeps oscillating
 
 
-def test_synchronisation_puts_the_damped_energy_into_the_common_motion():
-    """(S2): the common motion gains what the damping term takes, d|V_c|^2/dt = g k_s |V_j - V_i|^2,
-    integrated here from the recorded velocities; and the speeds end synchronised."""
-    relative = 0.6
-    tr = tmem.simulate(_pair(0.0, relative, synchronise=True))
+def _mean_square_speed(tr):
     v = tr.model.velocity(tr.state)  # (records, agents, axes)
-    a, b, k = _independent_loop()
-    k_s = synchronising_gain(a, b, k, 0.7)
-    damped = G * k_s * ((v[:, 1] - v[:, 0]) ** 2).sum(axis=1)
-    taken = np.sum(0.5 * (damped[1:] + damped[:-1]) * np.diff(tr.time))
-    common2 = (0.25 * (v[:, 0] + v[:, 1]) ** 2).sum(axis=1)
-    assert common2[-1] - common2[0] == pytest.approx(taken, rel=0.01)
-    assert taken > 0.05  # the relative motion's energy, |V_j - V_i|^2 / 4 = 0.09, mostly went there
+    return (v**2).sum(axis=2).mean(axis=1)
+
+
+def test_synchronisation_puts_the_damped_energy_into_the_common_motion():
+    """(S2)-(S3): the pair keeps its mean square speed E while its relative motion, a tenth of E, is
+    damped away; without the common push E would end at |V_c(0)|^2, 10 % lower.  The speeds end
+    synchronised, and the common motion sped up along its own direction."""
+    relative = 2.0
+    tr = tmem.simulate(_pair(0.0, relative, synchronise=True))
+    v = tr.model.velocity(tr.state)
+    energy = _mean_square_speed(tr)
+    assert energy[0] == pytest.approx(10.0)  # 3^2 + (2/2)^2
+    assert energy[-1] == pytest.approx(energy[0], rel=1e-3)
+    assert np.abs(energy / energy[0] - 1).max() < 0.02  # held all along, not only at the end
     assert np.linalg.norm(v[-1, 1] - v[-1, 0]) < 0.01 * relative  # the speeds are synchronised
-    assert v[-1, 0, 1] > 3.0  # the common motion sped up along its own direction (y)
+    assert v[-1, 0, 1] == pytest.approx(np.sqrt(10.0), rel=1e-3)  # all of it along y, the common motion
+
+
+def test_a_synchronised_encounter_keeps_the_rms_velocity():
+    """Two agents meet at an angle, couple, and are uncoupled by the operator.  Synchronised, the pair
+    ends with the mean square speed it had when it came within reach (the start here), and its
+    oscillation while coupled dies out; unsynchronised it keeps oscillating."""
+    for function in ("switching", "improved"):
+        runs = {
+            sync: tmem.simulate(_uncoupled_pair(
+                f'function = "{function}"\nsynchronise = {sync}', [([0.0, 0.0], [2.0, 1.0]), ([38.0, 6.0], [-1.0, 0.5])],
+                command=25.0, duration=70.0, record_every=10, axes=2))
+            for sync in ("true", "false")
+        }  # fmt: skip
+        tr = runs["true"]
+        kinds = [e.kind for e in tr.events]
+        assert kinds == ["couple", "command", "uncouple"], function
+        energy = _mean_square_speed(tr)
+        assert abs(energy[-1] / energy[0] - 1) < 2e-3, function  # RMS within 0.1 %
+        coupled = np.flatnonzero(tr.flag[:, 0] == 1)
+        late = coupled[tr.time[coupled] > tr.time[coupled[0]] + 15.0]
+        assert np.ptp(tr.pair_distance[late, 0]) < 0.2, function  # amplitude below 0.1 m
+        free = runs["false"]
+        assert np.ptp(free.pair_distance[late, 0]) > 0.5, function
 
 
 def _energy_release(tr, command_step, tolerance, function="improved"):
@@ -129,28 +155,29 @@ def _energy_release(tr, command_step, tolerance, function="improved"):
     return None
 
 
-def _scenario(tolerance):
-    return tmem.loads(f"""
-name = "head-on"
+def _uncoupled_pair(interaction, agents, command, duration, record_every, axes=1):
+    """Two agents ``[(position, velocity), ...]`` uncoupled by the operator at ``command`` (s);
+    ``interaction``: the ``[interaction]`` keys, one per line."""
+    listed = "".join(f"[[agents]]\nposition = {p}\nvelocity = {v}\n" for p, v in agents)
+    return tmem.loads(f"""name = "pair"
+[space]
+axes = {axes}
 [interaction]
-function = "improved"
-uncouple_when = "energy"
-energy_tolerance = {tolerance}
-[[agents]]
-position = 0.0
-velocity = 2.6
-[[agents]]
-position = 55.0
-velocity = -1.2
-[[commands]]
-time = 15.0
+{interaction}
+{listed}[[commands]]
+time = {command}
 action = "uncouple"
 pair = [0, 1]
 [simulation]
 dt = 0.001
-duration = 40.0
-record_every = 1
+duration = {duration}
+record_every = {record_every}
 """)
+
+
+def _scenario(tolerance):
+    return _uncoupled_pair(f'function = "improved"\nuncouple_when = "energy"\nenergy_tolerance = {tolerance}',
+                           [(0.0, 2.6), (55.0, -1.2)], command=15.0, duration=40.0, record_every=1)  # fmt: skip
 
 
 def test_energy_rule_releases_where_energy_and_gap_match():

@@ -1,8 +1,9 @@
 """The paper's three simulations (Figs. 5, 7, 9) and the side-by-side report.
 
 :data:`PAPER` holds what the paper states for each figure; :func:`run_paper`
-runs the shipped presets and :func:`report` sets our measurements beside the
-paper's statements, with a sentence on each difference.
+runs the shipped presets, and the reruns of Figs. 7 and 9 under the paper's
+further work (:mod:`tmem.further`), and :func:`report` sets our measurements
+beside the paper's statements, with a sentence on each difference.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .engine import Trajectory, simulate
+from .further import FURTHER, further_section
 from .io import write_run_files
 from .outputs import replace_directory
 from .scenario import preset
@@ -45,7 +47,8 @@ PAPER = {
 def run_paper(
     out: str | Path, progress: Callable[[str, int, int], None] | None = None
 ) -> tuple[dict[str, dict], str]:
-    """Run the presets ``fig5``, ``fig7``, ``fig9`` into ``out/<name>`` and write ``out/report.md``.
+    """Run the presets ``fig5``, ``fig7``, ``fig9`` and the reruns of :data:`tmem.further.FURTHER` into
+    ``out/<name>``, and write ``out/report.md``.
 
     Returns the summaries by preset name and the report text.
 
@@ -54,18 +57,19 @@ def run_paper(
     out : str or Path
         The output directory (:func:`tmem.io.check_output_directory` says which may be replaced).
     progress : callable or None
-        Called as ``progress(preset, steps_done, steps_total)`` during each run.
+        Called as ``progress(name, steps_done, steps_total)`` during each run.
     """
     summaries: dict[str, dict] = {}
     trajectories: dict[str, Trajectory] = {}
+    runs = {name: preset(name) for name in PAPER} | {name: variant.scenario() for name, variant in FURTHER.items()}
     with replace_directory(out, "paper") as tmp:
-        for name in PAPER:
+        for name, scenario in runs.items():
 
             def step(done: int, total: int, name: str = name) -> None:
                 if progress is not None:
                     progress(name, done, total)
 
-            trajectories[name] = simulate(preset(name), progress=step)
+            trajectories[name] = simulate(scenario, progress=step)
             run_dir = tmp / name
             run_dir.mkdir()
             summaries[name] = write_run_files(trajectories[name], run_dir)
@@ -176,10 +180,9 @@ def _comparison(summaries: dict[str, dict]) -> str:
 _CLOSING = [
     "**Why the RMS changes differ.** The paper does not give c_max, d_t, eps or its time step. "
     "docs/sensitivity.md shows how the RMS change moves with each of them (strongly for (10), little for "
-    "(11)), and docs/convergence.md how it converges in dt. tmem switches F_en at the first step inside "
-    "the window of condition (9) (`interaction.switch_at = \"window\"`); the paper's further rule, to "
-    "uncouple when the kinetic energy and f1 − f2 equal their values at coupling, is not implemented. "
-    "docs/reproduction.md discusses each difference.",
+    "(11)), and docs/convergence.md how it converges in dt. The presets switch F_en at the first step inside "
+    "the window of condition (9) (`interaction.switch_at = \"window\"`, `interaction.uncouple_when = "
+    "\"window\"`); the paper's energy rule is rerun below. docs/reproduction.md discusses each difference.",
     "",
     "Each run's directory holds `summary.json`, `trajectory.nc` and the figures `velocity.png` "
     "(as the paper's velocity plots) and `distance.png`.",
@@ -193,7 +196,8 @@ def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> s
     Parameters
     ----------
     summaries
-        :func:`tmem.metrics.summarize` of each run, by preset name (fig5, fig7, fig9).
+        :func:`tmem.metrics.summarize` of each run, by name: the presets fig5, fig7, fig9 and the
+        reruns of :data:`tmem.further.FURTHER`.
     trajectories
         The runs themselves, by the same names.
 
@@ -223,4 +227,6 @@ def report(summaries: dict[str, dict], trajectories: dict[str, Trajectory]) -> s
     ]
     for note in notes:
         lines += [note, ""]
-    return "\n".join(lines + _CLOSING)
+    paper_rms = {name: PAPER[name].rms_change_percent for name in ("fig7", "fig9")}
+    lines += _CLOSING + further_section(summaries, trajectories, paper_rms, COMMAND_TIME)
+    return "\n".join(lines)

@@ -222,7 +222,8 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     n_edges = len(edges)
     pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
                   np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf),
-                  np.full(n_edges, np.nan), np.full(n_edges, np.nan), np.zeros(n_edges, dtype=np.int64),
+                  np.full(n_edges, np.nan), np.full(n_edges, np.nan), np.full(n_edges, np.nan),
+                  np.full(n_edges, np.nan), np.zeros(n_edges, dtype=np.int64),
                   np.empty(n_axes))  # fmt: skip
     commands = _commands(scenario, edges, slot)
     steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)

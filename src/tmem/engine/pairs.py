@@ -14,7 +14,7 @@ import numpy as np
 from .. import coupling
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
-from ..synchronise import synchronising_push
+from ..synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
 from .stages import log_event
 
 
@@ -64,7 +64,8 @@ def _next_flag(k, e, r, energy, pairs, law, params):
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
     """Add pair ``e``'s push to its agents, equal and opposite: (10)/(11) along ``d / |d|``, or, while
-    coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)`` saturated on its norm."""
+    coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)`` saturated on its norm.
+    On return ``d`` holds the push on agent ``i``."""
     i = pairs.i[e]
     j = pairs.j[e]
     if pairs.flag[e] == 1 and not np.isnan(pairs.direction[e, 0]):
@@ -72,16 +73,35 @@ def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
         for a in range(n_axes):
             d[a] = params.k_p * (d[a] - pairs.direction[e, a] * pairs.d_t[e])
             norm2 += d[a] * d[a]
-        scale = min(1.0, params.c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
-        for a in range(n_axes):
-            u[i, a] += scale * d[a]
-            u[j, a] -= scale * d[a]
-    elif r > 0.0:
+        push = min(1.0, params.c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
+    else:
         p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
-        push = pair_control(law.function, r, pairs.flag[e], p) / r
-        for a in range(n_axes):
-            u[i, a] += push * d[a]
-            u[j, a] -= push * d[a]
+        push = pair_control(law.function, r, pairs.flag[e], p) / r if r > 0.0 else 0.0
+    for a in range(n_axes):
+        d[a] *= push
+        u[i, a] += d[a]
+        u[j, a] -= d[a]
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _synchronise(e, r, dist, entering, pushed, known, pairs, law, params, n_axes, u):
+    """(S2) on pair ``e``: from its coupling, its relative motion damped and its mean square speed held
+    at its value when it came within reach; after it uncouples, the speed alone, until it is out of
+    reach again (:mod:`tmem.synchronise`).  ``pushed``: the pair's push on agent ``i`` this step."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if entering:
+        pairs.entry_speed2[e] = mean_square_speed(known, i, j, n_axes)
+    coupled = pairs.flag[e] == 1
+    kept = pairs.kept_speed2[e]
+    if coupled and np.isnan(kept):  # coupled now; one coupled beyond reach keeps the energy it has
+        kept = pairs.entry_speed2[e] if not np.isnan(pairs.entry_speed2[e]) else mean_square_speed(known, i, j, n_axes)
+    elif not coupled and min(r, dist) >= params.reach:  # gone: held until E is back at E*
+        if abs(mean_square_speed(known, i, j, n_axes) - kept) <= KEPT_TOLERANCE * kept:
+            kept = np.nan
+    pairs.kept_speed2[e] = kept
+    if not np.isnan(kept):
+        synchronising_push(known, i, j, law.sync_gain, coupled, kept, pushed, params.c_max, n_axes, u)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -109,6 +129,7 @@ def formation_pairs(k, known, agents, pairs, law, params, run, events, counters)
         if not (agents.active[i] and agents.active[j]):
             if pairs.flag[e] == 1:  # the pair is lost with its agent
                 pairs.flag[e] = 0
+                pairs.kept_speed2[e] = np.nan
                 log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1, coupling.RELEASE_LOST)
             pairs.r_before[e] = np.nan
             continue
@@ -123,7 +144,8 @@ def formation_pairs(k, known, agents, pairs, law, params, run, events, counters)
             if new != pairs.flag[e]:
                 pairs.flag[e] = new
                 log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1, released_by)
+        entering = r < params.reach and not pairs.r_before[e] < params.reach  # or at the first step
         pairs.r_before[e] = r
         _pair_pull(e, d, r, pairs, law, params, n_axes, agents.setpoint)
-        if pairs.flag[e] == 1 and law.sync_gain > 0.0:
-            synchronising_push(known, i, j, law.sync_gain, params.c_max, n_axes, agents.setpoint)
+        if law.sync_gain > 0.0:
+            _synchronise(e, r, dist, entering, d, known, pairs, law, params, n_axes, agents.setpoint)

@@ -137,6 +137,10 @@ class Pairs(NamedTuple):
     coupled_gap, coupled_energy : ndarray, shape (pairs,)
         ``f1 - f2`` and the relative kinetic energy at the pair's last coupling
         (:mod:`tmem.coupling`; NaN before it).
+    entry_speed2, kept_speed2 : ndarray, shape (pairs,)
+        Under synchronisation (:mod:`tmem.synchronise`): the pair's mean square speed
+        ``(|V_i|^2 + |V_j|^2) / 2`` when it last came within reach (or at the start), and ``E*``,
+        the value (S2) holds from its coupling until it is out of reach again (NaN: none).
     disarmed_at : ndarray, shape (pairs,), int
         The step of the last uncouple command to the pair.
     d : ndarray, shape (axes,)
@@ -154,6 +158,8 @@ class Pairs(NamedTuple):
     min_distance: np.ndarray
     coupled_gap: np.ndarray
     coupled_energy: np.ndarray
+    entry_speed2: np.ndarray
+    kept_speed2: np.ndarray
     disarmed_at: np.ndarray
     d: np.ndarray
 
