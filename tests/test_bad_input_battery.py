@@ -6,7 +6,7 @@ no traceback, and nothing written under ``--out``.  The cases are generated syst
 
 * every numeric field of a scenario x {negative, zero, nan, inf, -inf, huge, wrong type, list, table};
 * every table x {not a table, an unknown key}; every choice of names x {a typo};
-* the classes of issue 10 (items 5 and 6) and their neighbours: a periodic box narrower than
+* inputs once accepted although wrong, or refused with a traceback, and their neighbours: a periodic box narrower than
   R + R_j, duplicate or empty ``record_agents``, ``pairs = []``, a couple command with a function
   that never couples, a ``dt`` too coarse for the closed loop, ``im_r`` so small that K_P
   underflows, negative seeds, a huge ``record_every``, deeply nested TOML, a FIFO or a device as
@@ -172,7 +172,7 @@ for path, base, typo in [("model.kind", FIG9, "lineer"), ("interaction.function"
 case("space.axes 4", changed(FIG9, "space.axes", 4), "space.axes")
 case("space.periodic as text", changed(SWARM, "space.periodic", "yes"), "space.periodic")
 
-# -- issue 10, item 6: accepted although wrong --------------------------------------------------------
+# -- accepted although wrong ----------------------------------------------------------------------------
 
 for side in (10.0, 39.9):
     case(f"periodic box {side} below reach", changed(SWARM, "space.box", [side, 200.0]), "space.box[0]")
@@ -201,7 +201,7 @@ case("dt too coarse for fast roots", changed(changed(FIG9, "controller.r_l", 300
 case("dt too coarse for a fast right pair", changed(changed(FIG9, "controller.im_r", 200.0), "simulation.dt", 0.001),
      "simulation.dt")
 
-# -- issue 10, item 5: validation that let tracebacks through ----------------------------------------
+# -- validation that let tracebacks through --------------------------------------------------------------
 
 for im_r in (1e-160, 1e-200, 5e-324):
     case(f"im_r {im_r} underflows K_P", changed(FIG9, "controller.im_r", im_r), "controller.im_r")

@@ -35,23 +35,6 @@ ROOT = Path(__file__).parent.parent
 SIGNALS = {"SIGINT": signal.SIGINT, "SIGTERM": signal.SIGTERM, "SIGKILL": signal.SIGKILL}
 # The repulsion example, long: a few seconds of simulation behind a progress bar, then a few MB to write.
 LONG_RUN = (ROOT / "examples" / "repulsion.toml").read_text().replace("duration = 60.0", "duration = 600.0")
-PAIR_2D = """
-name = "pair2d"
-[space]
-axes = 2
-[interaction]
-function = "improved"
-[simulation]
-dt = 0.001
-duration = 40.0
-record_every = 10
-[[agents]]
-position = [50.0, 0.0]
-velocity = [-1.5, 0.0]
-[[agents]]
-position = [0.0, 0.0]
-velocity = [3.0, 0.0]
-"""
 SWEEP = """
 name = "encounters"
 base = "fig7"
@@ -207,10 +190,9 @@ def test_interrupted_run_leaves_the_earlier_output_or_a_whole_new_one(long_run, 
 
 
 @pytest.fixture(scope="module")
-def run_2d(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("pair2d")
-    scenario = folder / "pair2d.toml"
-    scenario.write_text(PAIR_2D)
+def run_2d(pair_2d_factory):
+    scenario = pair_2d_factory(40.0, 10)
+    folder = scenario.parent
     result = CliRunner().invoke(app, ["run", str(scenario), "--out", str(folder / "run")])
     assert result.exit_code == 0, result.output
     return folder / "run"

@@ -20,23 +20,6 @@ from tmem.sweep import loads_sweep, run_sweep
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 SRC = Path(__file__).parent.parent / "src"
-# Two agents in the plane, short and coarse: a run of a second or so that `animate` can draw.
-PAIR_2D = """
-name = "pair2d"
-[space]
-axes = 2
-[interaction]
-function = "improved"
-[simulation]
-dt = 0.001
-duration = 20.0
-[[agents]]
-position = [50.0, 0.0]
-velocity = [-1.5, 0.0]
-[[agents]]
-position = [0.0, 0.0]
-velocity = [3.0, 0.0]
-"""
 SWEEP = """
 name = "small"
 base = "fig7"
@@ -77,11 +60,9 @@ def dead_pid() -> int:
 
 
 @pytest.fixture(scope="module")
-def pair_2d(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("pair")
-    scenario = folder / "pair2d.toml"
-    scenario.write_text(PAIR_2D)
-    return scenario
+def pair_2d(pair_2d_factory):
+    """Two agents in the plane, short and coarse: a run of a second or so that `animate` can draw."""
+    return pair_2d_factory(20.0, 100)
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""What the reproduction must show (issue: Figs. 5, 7, 9 and the repulsion encounter).
+"""What the reproduction must show: Figs. 5, 7, 9 and the repulsion encounter.
 
 The paper's start (Table 2) and several others.  The other starts have a
 closing speed of 4-5 m/s like Table 2's 4.5 m/s; docs/reproduction.md explains

@@ -88,7 +88,7 @@ def test_blocks_keep_verlet_lists_and_all_pairs_equal(monkeypatch, axes):
     monkeypatch.setattr(engine, "BLOCK", 4096)
     one = tmem.simulate(random_swarm(500, axes, True, "verlet", steps=100))
     assert one.final_state.tobytes() != b.final_state.tobytes()  # the order did change
-    # the tolerance for another order; measured after 100 steps: 3.4e-15 at most
+    # the tolerance allowed for another summation order; measured after 100 steps: 3.4e-15 at most
     np.testing.assert_allclose(b.final_state, one.final_state, rtol=0, atol=1e-12)
 
 
