@@ -138,7 +138,8 @@ def run_arrays(scenario) -> dict[str, np.ndarray]:
 def batch_arrays(result, prefix: str = "") -> dict[str, np.ndarray]:
     """Every array of a ``BatchResult``."""
     fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
-    return {prefix + name: value for name, value in fields.items() if isinstance(value, np.ndarray)}
+    return {prefix + name: value.astype(str) if value.dtype == object else value
+            for name, value in fields.items() if isinstance(value, np.ndarray)}  # fmt: skip
 
 
 # --- the scenarios -------------------------------------------------------------------------------

@@ -51,3 +51,14 @@ def test_model_without_kind_is_the_linear_model():
     older = text.replace('kind = "linear"\n', "", 1)
     assert tmem.loads(older) == tmem.preset("fig9")
     assert tmem.loads(older).model.kind == "linear"
+
+
+def test_the_plane_encounter_is_fig7_in_the_plane():
+    """examples/encounter_plane.toml, the base of the plane study, differs from the Fig. 7 preset only
+    in its axes and in Table 2's start written as vectors along x."""
+    plane, fig7 = tmem.load(EXAMPLES / "encounter_plane.toml"), tmem.preset("fig7")
+    for table in ("model", "controller", "interaction", "simulation", "commands", "neighbors"):
+        assert getattr(plane, table) == getattr(fig7, table), table
+    assert plane.space.axes == 2
+    for ours, theirs in zip(plane.agents, fig7.agents, strict=True):
+        assert ours.position == [theirs.position, 0.0] and ours.velocity == [theirs.velocity, 0.0]

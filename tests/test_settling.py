@@ -11,7 +11,6 @@ import pytest
 from scipy.signal import place_poles
 
 import tmem
-from tmem.batch import unsupported
 from tmem.interaction import evaluate
 from tmem.metrics import SETTLE_BAND, summarize
 from tmem.scenario import with_changes
@@ -207,13 +206,6 @@ def test_window_rule_names_itself_and_the_default_is_unchanged():
     (released,) = [e for e in tr.events if e.kind == "uncouple"]
     assert released.rule == "window" and released.time == pytest.approx(30.7925)
     assert summarize(tr)["events"][-1]["rule"] == "window"
-
-
-def test_the_batch_leaves_the_new_rules_to_the_engine():
-    fig9 = tmem.preset("fig9")
-    assert unsupported(fig9) is None
-    assert unsupported(with_changes(fig9, {"interaction.uncouple_when": "energy"})) is not None
-    assert unsupported(with_changes(fig9, {"interaction.synchronise": True})) is not None
 
 
 def test_settling_time_is_the_start_of_the_last_stay_within_the_band():

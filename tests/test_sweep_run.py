@@ -59,6 +59,44 @@ def test_batched_rows_equal_single_runs_of_the_engine():
         assert row["coupled"] == one["coupled"]
         for m in ("couple_time", "uncouple_time"):
             assert (row[m] is None and one[m] is None) or row[m] == pytest.approx(one[m], abs=1e-9)
+        assert row["uncouple_rule"] == one["uncouple_rule"]
+
+
+# Encounters at an angle, under explicit cases that set different keys.
+PLANE = """
+name = "plane"
+base = "../encounter_plane.toml"
+cases = 3
+seed = 2
+[set]
+"simulation.dt" = 0.001
+"simulation.duration" = 45.0
+"interaction.function" = "improved"
+[random]
+"agents.0.position" = { polar = [[45.0, 60.0], [-15.0, 15.0]] }
+"agents.0.velocity" = { polar = [[2.0, 4.0], [160.0, 200.0]] }
+"agents.1.velocity" = { polar = [[2.0, 4.0], [-20.0, 20.0]] }
+[[case]]
+"interaction.uncouple_when" = "energy"
+[[case]]
+"interaction.synchronise" = true
+"""
+
+
+def test_explicit_cases_with_different_keys_in_the_plane(cluster, tmp_path):
+    """A key that only some explicit cases set is empty in the others' rows; each row's figures and
+    uncoupling rule are those of tmem.simulate for the same case."""
+    sweep = loads_sweep(PLANE, source="plane.toml", directory=Path(__file__).parent.parent / "examples" / "sweeps")
+    outcome = run_sweep(sweep, tmp_path / "out", scheduler=cluster.scheduler_address)
+    table = outcome.table
+    assert outcome.failed == 0 and len(table) == 6
+    assert table["interaction.synchronise"].isna().tolist() == [True] * 3 + [False] * 3
+    for case, row in zip(sweep.cases(), table.itertuples(index=False)):
+        one = summarize(tmem.simulate(with_changes(sweep.base, case.changes)))
+        assert row.rms_change_percent == pytest.approx(one["rms_change_percent"], abs=1e-7)
+        assert (pd.isna(row.uncouple_rule) and one["uncouple_rule"] is None) or row.uncouple_rule == one["uncouple_rule"]
+    assert set(table["uncouple_rule"].dropna()) <= {"window", "energy", "fallback"}
+    assert "## What released the pairs" in (tmp_path / "out" / "summary.md").read_text()
 
 
 def test_a_failing_case_is_a_row_with_its_error_and_the_others_run():

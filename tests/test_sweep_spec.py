@@ -73,6 +73,22 @@ seed = {seed}
     assert abs(normal.mean() - 3.0) < 0.05 and abs(normal.std() - 0.5) < 0.05
 
 
+def test_polar_draws_are_uniform_in_length_and_direction():
+    """Checked against the draw's definition: the length and the angle of each vector, recovered with
+    numpy's hypot and arctan2, fill their ranges uniformly (Kolmogorov-Smirnov against scipy's uniform)."""
+    from scipy.stats import kstest
+
+    swept = loads_sweep('name = "t"\nbase = "../encounter_plane.toml"\ncases = 4000\nseed = 3\n[random]\n'
+                        '"agents.0.velocity" = { polar = [[1.0, 5.0], [150.0, 210.0]] }\n',
+                        directory=Path(__file__).parent.parent / "examples" / "sweeps")  # fmt: skip
+    v = np.array([case.changes["agents.0.velocity"] for case in swept.cases()])
+    length = np.hypot(v[:, 0], v[:, 1])
+    angle = np.degrees(np.arctan2(v[:, 1], v[:, 0])) % 360.0
+    assert kstest(length, "uniform", args=(1.0, 4.0)).pvalue > 0.01
+    assert kstest(angle, "uniform", args=(150.0, 60.0)).pvalue > 0.01
+    assert 1.0 <= length.min() and length.max() <= 5.0
+
+
 def test_nested_tables_mean_the_same_paths_as_quoted_keys():
     quoted = sweep('[grid]\n"interaction.c_max" = [0.05, 0.1]\n')
     nested = sweep("[grid]\ninteraction.c_max = [0.05, 0.1]\n")
@@ -103,6 +119,9 @@ def test_set_changes_the_base_and_fingerprint_ignores_batch_only():
         ('cases = 2\n[random]\n"interaction.eps" = { loguniform = [0.0, 0.2] }\n', "loguniform: low must be > 0"),
         ('cases = 0\n[random]\n"interaction.eps" = { uniform = [0.1, 0.2] }\n', "cases: must be greater than or equal to 1"),
         ("sedd = 3\n", "sedd: unknown key"),
+        ('cases = 2\n[random]\n"interaction.eps" = { polar = [[2, 1], [0, 90]] }\n', "polar: the lengths must have 0 <= low <= high"),
+        ('cases = 2\n[random]\n"interaction.eps" = { polar = [[1, 2], [90, 0]] }\n', "polar: the directions must have from <= to"),
+        ('cases = 2\n[random]\n"interaction.eps" = { polar = [[1, 2]] }\n', "random.interaction.eps.polar"),
         ('[grid]\n"coupled" = [1.0]\n', "grid.coupled: is a column of the results"),
     ],
 )

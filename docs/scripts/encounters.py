@@ -1,7 +1,7 @@
-"""The encounter study's write-up, from the results of its sweep.
+"""The head-on encounter study's write-up, from the results of its sweep.
 
 Run the sweep, then this script on its output directory; it writes
-``docs/encounters.md`` and its figures under ``docs/encounters/``::
+``docs/encounters_head_on.md`` and its figures under ``docs/encounters/``::
 
     tmem sweep examples/sweeps/encounters.toml --out out/encounters
     python docs/scripts/encounters.py out/encounters
@@ -14,20 +14,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import matplotlib
+from study import DOCS, FIGURES, FUNCTION, LABEL, PAPER_RMS, panels_by_function  # first: it selects matplotlib's file backend
 
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from tmem.paper import PAPER  # noqa: E402
-
-DOCS = Path(__file__).resolve().parents[1]
-FIGURES = DOCS / "encounters"
-FUNCTION = "interaction.function"
-LABEL = {"switching": "switching (10)", "improved": "improved (11)"}
-PAPER_RMS = {"switching": PAPER["fig7"].rms_change_percent, "improved": PAPER["fig9"].rms_change_percent}
 COMMAND_TIME = 29.0
 SPEED_BINS = np.arange(2.0, 10.5, 1.0)
 
@@ -66,18 +58,11 @@ def describe(group: pd.DataFrame, function: str) -> dict:
 
 
 def figures(table: pd.DataFrame) -> None:
-    FIGURES.mkdir(exist_ok=True)
-    fig, axes = plt.subplots(2, 1, figsize=(7, 5.2))
-    for ax, (function, group) in zip(axes, table.groupby(FUNCTION, sort=False)):
+    def draw(ax, function, group):
         ax.hist(group["rms_change_percent"], bins=60, color="tab:blue")
         ax.axvline(PAPER_RMS[function], color="tab:red", ls="--", label=f"paper: {PAPER_RMS[function]} %")
-        ax.set_title(LABEL[function], fontsize=10)
-        ax.set_ylabel("encounters")
-        ax.legend(fontsize=8)
-    axes[-1].set_xlabel("RMS velocity change (%)")
-    fig.tight_layout()
-    fig.savefig(FIGURES / "rms_change_histogram.png", dpi=100)
-    plt.close(fig)
+
+    panels_by_function(table, draw, "RMS velocity change (%)", "rms_change_histogram.png")
 
     fig, ax = plt.subplots(figsize=(7, 4))
     for function, group in table.groupby(FUNCTION, sort=False):
@@ -194,7 +179,7 @@ Pairs that did not couple met through the repulsion branch alone and parted; the
 So "similar under other initial conditions" holds for (11), and for the ranking of (10) against (11); it
 does not hold for the size of (10)'s RMS change, and coupling fails for slow approaches.
 """
-    (DOCS / "encounters.md").write_text(text, encoding="utf-8")
+    (DOCS / "encounters_head_on.md").write_text(text, encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -1,19 +1,25 @@
-"""Many two-agent, one-axis encounters at once: the paper's case as a vectorised batch.
+"""Many two-agent encounters at once: the paper's case, and its like in 2-D and 3-D, as a batch.
 
-For two agents on one axis the pushes are equal and opposite, also after
-saturation (the clip is odd), so the sum ``x_0 + x_1`` flies free and only
-the relative state ``e = x_1 - x_0`` feels the interaction::
+Each case is two agents flying from level starts, with no other agent, in
+open space; only their starts differ.  A batch runs the cases side by side,
+:data:`LANES` at a time in one compiled loop, each case with the step
+loop's own formation-pair stage (:func:`tmem.engine.pairs.formation_pair`:
+the flag (9) or the energy rule, the pull (10)/(11), the synchronisation
+(S2)) and the vehicle model's step, so that a case gives what
+:func:`tmem.simulate` gives for it.
 
-    e[k+1] = Ad e[k] + Bd (U_1 - U_0) = Ad e[k] - 2 Bd U_0,
-    U_0 = sat(f(|d|) sign(d)),   d = K . e / K_P   (6)
-
-One step of one case is then a handful of multiply-adds, and cases are
-independent, so a batch runs them side by side in one compiled loop.  Free
-flight (uncoupled, out of reach, the tilt died out) moves ``d`` at a constant
-rate and is skipped in closed form: to the end once the pair separates, to
-just before contact while it closes.  The
-figures are those of :func:`tmem.metrics.summarize` for the same scenario
-(tests compare the two), without recording trajectories.
+The paper's own case, one axis under the window rule (9) without
+synchronisation, reduces to the pair's relative state and runs about three
+times faster (:mod:`tmem.relative_batch`); every other case steps both agents.
+What the batch adds is free flight in closed form.  A pair that is uncoupled,
+out of reach, level (its tilts died out) and not holding a synchronised
+energy feels no push, so its agents fly at constant velocity and the pair's
+``P*_j - P*_i`` (``P* = P + (K_V / K_P) V`` when level) moves at their relative
+velocity ``w``: the flight is skipped to the end if
+``|P*_j - P*_i|`` never comes back within ``R + R_j + eps``, else to just
+before it does.  The smallest distance over a skip is found in closed form.
+The figures are those of :func:`tmem.metrics.summarize` for the same
+scenario (tests compare the two), without recording trajectories.
 """
 
 from __future__ import annotations
@@ -24,11 +30,13 @@ import numba
 import numpy as np
 
 from . import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
-from .control import corrected_position, gains_for
+from .control import corrected_position, gains_for, tilt_scale
 from .engine.driver import law_of
-from .interaction.kernels import pair_control
+from .engine.pairs import formation_pair
+from .engine.records import Agents, Counters, Events, Pairs
 from .model import vehicle_model
-from .model.linear import hold_step
+from .model.linear import step_zero_order_hold
+from .relative_batch import LANES, run_relative
 from .scenario import LIMIT, Scenario
 
 
@@ -43,7 +51,8 @@ class BatchResult:
     final_distance: np.ndarray
     couple_time: np.ndarray
     uncouple_time: np.ndarray
-    final_velocities: np.ndarray  # (cases, 2)
+    uncouple_rule: np.ndarray  # what released the pair (tmem.coupling.RELEASES), None if nothing did
+    final_velocities: np.ndarray  # (cases, 2, axes)
 
     @property
     def coupled(self) -> np.ndarray:
@@ -51,105 +60,167 @@ class BatchResult:
         return ~np.isnan(self.couple_time)
 
 
-#: Cases advanced side by side in one loop.  One case's step depends on its last, so alone it waits
-#: on its own arithmetic; interleaving independent cases lets the processor overlap them.
-LANES = 8
 
 
-@numba.njit(cache=True, inline="always")
-def _free_flight_steps(d, velocity, steps_left, gap, dt):
-    """Steps a free pair (uncoupled, level, ``gap`` m beyond reach and window) may skip: every step
-    left if it separates (``d`` grows), else those before it could close the gap at ``velocity``."""
-    closing = -velocity if d > 0 else velocity
-    if closing <= 0.0:
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _free_flight_steps(x, corrected, i, j, reach, steps_left, dt):
+    """Steps the free pair ``(i, j)`` may skip: every step left if ``|P*_j - P*_i|`` does not come back
+    within ``reach`` at the relative velocity ``w`` (level, ``P*`` moves at ``V``), else those before it could."""
+    b = 0.0  # d . w
+    w2 = 0.0
+    d2 = 0.0
+    for a in range(x.shape[1]):
+        d = corrected[j, a, 0] - corrected[i, a, 0]
+        w = x[j, a, 1] - x[i, a, 1]
+        b += d * w
+        w2 += w * w
+        d2 += d * d
+    disc = b * b - w2 * (d2 - reach * reach)
+    if b >= 0.0 or disc < 0.0:  # parting, or passing wide
         return steps_left
-    return min(steps_left, int(gap / (closing * dt)) - 1)
+    t = (-b - np.sqrt(disc)) / w2
+    return min(steps_left, int(t / dt) - 1)
 
 
-# fastmath "contract" only: the multiply-adds may fuse (one rounding instead of two); NaN and
-# infinity keep their meaning, which the flag logic relies on (r_before is NaN after a skip).
-@numba.njit(cache=True, parallel=True, error_model="numpy", fastmath={"contract"})
-def _run_batch(e0, n_steps, dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step):
-    """Advance each case of ``e0`` (cases, 4) ``n_steps`` steps of ``dt`` under ``law`` with the
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _closest_in_flight(x, i, j, steps, dt):
+    """The smallest ``|P_j - P_i|`` at the steps ``0 .. steps - 1`` of a free flight of the pair."""
+    b = 0.0
+    w2 = 0.0
+    for a in range(x.shape[1]):
+        b += (x[j, a, 0] - x[i, a, 0]) * (x[j, a, 1] - x[i, a, 1])
+        w2 += (x[j, a, 1] - x[i, a, 1]) ** 2
+    nearest = np.inf
+    at = 0.0 if w2 == 0.0 else -b / (w2 * dt)  # the closest step, between two whole ones
+    for m in (np.floor(at), np.floor(at) + 1.0):
+        m = min(max(m, 0.0), steps - 1.0)
+        dist2 = 0.0
+        for a in range(x.shape[1]):
+            dist2 += (x[j, a, 0] - x[i, a, 0] + (x[j, a, 1] - x[i, a, 1]) * m * dt) ** 2
+        nearest = min(nearest, np.sqrt(dist2))
+    return nearest
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _is_free(x, e, pairs, r, reach):
+    """Pair ``e`` feels nothing this step: uncoupled, ``|d|`` beyond ``reach``, level, holding no energy."""
+    if pairs.flag[e] != 0 or r <= reach or not np.isnan(pairs.kept_speed2[e]):
+        return False
+    for s in (pairs.i[e], pairs.j[e]):
+        for a in range(x.shape[1]):
+            if abs(x[s, a, 2]) >= 1e-13 or abs(x[s, a, 3]) >= 1e-12:
+                return False
+    return True
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _case_step(k, e, x, agents, pairs, law, params, box, hold, command_step, n_steps, dt, events, counters):
+    """One step of case ``e`` (agents ``2e``, ``2e + 1``) from step ``k``, or one skip of its free flight;
+    return the step it reaches."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    n_axes = len(box)
+    if k == command_step:
+        pairs.armed[e] = 0
+        pairs.disarmed_at[e] = k
+    r2 = 0.0
+    for s in (i, j):
+        for a in range(n_axes):
+            agents.corrected[s, a, 0] = corrected_position(x[s, a, 0], x[s, a, 1], x[s, a, 2], x[s, a, 3], law.gains, s - i)
+            agents.corrected[s, a, 1] = x[s, a, 0]
+            agents.setpoint[s, a] = 0.0
+    for a in range(n_axes):
+        r2 += (agents.corrected[j, a, 0] - agents.corrected[i, a, 0]) ** 2
+    if k < n_steps and _is_free(x, e, pairs, np.sqrt(r2), params.reach + law.eps):
+        skip = _free_flight_steps(x, agents.corrected, i, j, params.reach + law.eps, n_steps - k, dt)
+        if skip > 1:
+            if k < command_step <= k + skip:
+                pairs.armed[e] = 0
+                pairs.disarmed_at[e] = command_step
+            pairs.min_distance[e] = min(pairs.min_distance[e], _closest_in_flight(x, i, j, skip, dt))
+            for s in (i, j):
+                for a in range(n_axes):
+                    x[s, a, 0] += x[s, a, 1] * (skip * dt)
+            pairs.r_before[e] = np.nan
+            return k + skip
+    formation_pair(k, e, x, agents, pairs, law, params, box, events, counters)
+    if k < n_steps:
+        for s in (i, j):
+            step_zero_order_hold(x, agents.setpoint, s, tilt_scale(agents.setpoint, s, n_axes, params.c_max), hold, n_axes)
+    return k + 1
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def _advance_block(k, x, agents, pairs, law, params, box, hold, command_step, n_steps, dt, events, counters):
+    """Every case of a block to its end: one step (or one skip) of each in turn, so that the
+    processor overlaps independent cases.  Without Numba's runtime, as the step loop
+    (:mod:`tmem.engine.loop`): a reference count on every record field read made it three times slower."""
+    running = len(k)
+    while running > 0:
+        running = 0
+        for c in range(len(k)):
+            if k[c] <= n_steps:
+                running += 1
+                k[c] = _case_step(k[c], c, x, agents, pairs, law, params, box, hold, command_step, n_steps, dt, events, counters)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _run_block(first, lanes, starts, n_steps, dt, command_step, hold, law, params, box, ends, min_dist, couple_step, uncouple_step, rule):
+    """Cases ``first .. first + lanes - 1`` of :func:`_run_batch`, side by side, with records of their own
+    as the step loop's for a swarm of ``2 lanes`` agents.  (Called from the parallel loop, not inlined
+    in it: a parallel loop takes records only as arguments.)"""
+    n_axes = len(box)
+    x = np.zeros((2 * lanes, n_axes, 4))
+    for c in range(lanes):
+        x[2 * c : 2 * c + 2] = starts[first + c]
+    agents = Agents(x, x, np.ones(2 * lanes, dtype=np.bool_), np.zeros((2 * lanes, n_axes, 2)), np.zeros((2 * lanes, n_axes)))
+    nan = np.full(lanes, np.nan)
+    pairs = Pairs(np.arange(0, 2 * lanes, 2), np.arange(1, 2 * lanes, 2), np.full(lanes, params.d_t),
+                  np.full((lanes, n_axes), np.nan), np.zeros(lanes, dtype=np.int64), np.ones(lanes, dtype=np.int64),
+                  nan.copy(), np.full(lanes, np.inf), nan.copy(), nan.copy(), nan.copy(), nan.copy(),
+                  np.zeros(lanes, dtype=np.int64), np.empty(n_axes))  # fmt: skip
+    room = 4 * lanes  # a case couples once before the command and uncouples once after it
+    events = Events(np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64),
+                    np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64))  # fmt: skip
+    counters = Counters(np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64),
+                        np.zeros(1, dtype=np.int64))  # fmt: skip
+    _advance_block(np.zeros(lanes, dtype=np.int64), x, agents, pairs, law, params, box, hold, command_step, n_steps, dt,
+                   events, counters)  # fmt: skip
+    for c in range(lanes):
+        ends[first + c] = x[2 * c : 2 * c + 2]
+        min_dist[first + c] = pairs.min_distance[c]
+        couple_step[first + c] = -1
+        uncouple_step[first + c] = -1
+        rule[first + c] = -1
+    for n in range(counters.n_events[0]):
+        c = first + events.i[n] // 2
+        if events.kind[n] == coupling.EVENT_COUPLE and couple_step[c] < 0:
+            couple_step[c] = events.step[n]
+        if events.kind[n] == coupling.EVENT_UNCOUPLE and uncouple_step[c] < 0:
+            uncouple_step[c] = events.step[n]
+            rule[c] = events.rule[n]
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def _run_batch(starts, n_steps, dt, command_step, hold, law, params, box, ends, min_dist, couple_step, uncouple_step, rule):
+    """Advance each case of ``starts`` (cases, 2, axes, 4) ``n_steps`` steps of ``dt`` under ``law`` with the
     functions' parameters ``params`` and the zero-order hold ``hold`` of the linear model; write each
-    case's end, smallest distance, and the steps it first coupled and uncoupled (-1: never).
-    (Records are used inside the parallel loop only as arguments: see :class:`tmem.engine.records.Law`.)
-    The two agents of a case are alike: ``P*`` (6) of their relative state uses the law's first row of gains."""
-    gains = law.gains
-    reach, d_t, eps, c_max = params.reach, params.d_t, law.eps, params.c_max
-    function, couples, at_crossing = law.function, law.couples, law.at_crossing
-    ad, bd = hold.ad, hold.bd
-    n_cases = e0.shape[0]
+    case's end state, smallest distance, the steps it first coupled and uncoupled (-1: never) and the
+    rule that released it (-1: none).  Blocks of :data:`LANES` cases run on the threads."""
+    n_cases = starts.shape[0]
     for block in numba.prange((n_cases + LANES - 1) // LANES):
         first = block * LANES
-        lanes = min(LANES, n_cases - first)
-        e_p = np.empty(LANES)
-        e_v = np.empty(LANES)
-        e_phi = np.empty(LANES)
-        e_om = np.empty(LANES)
-        flag = np.zeros(LANES, dtype=np.int64)
-        armed = np.ones(LANES, dtype=np.int64)
-        r_before = np.full(LANES, np.nan)
-        lowest = np.full(LANES, np.inf)
-        coupled_at = np.full(LANES, -1)
-        uncoupled_at = np.full(LANES, -1)
-        k = np.zeros(LANES, dtype=np.int64)
-        for lane in range(lanes):
-            e_p[lane], e_v[lane], e_phi[lane], e_om[lane] = e0[first + lane]
-        running = lanes
-        while running > 0:
-            running = 0
-            for c in range(lanes):  # one step (or one skip) of every case still running
-                if k[c] > n_steps:
-                    continue
-                running += 1
-                if k[c] == command_step:
-                    armed[c] = 0
-                d = corrected_position(e_p[c], e_v[c], e_phi[c], e_om[c], gains, 0)
-                r = abs(d)
-                lowest[c] = min(lowest[c], abs(e_p[c]))
-                # Free flight: uncoupled, out of reach, level (the tilt has died out).  Then
-                # d = P + (K_V / K_P) V moves at the constant rate V, so the flight is skipped in
-                # closed form: to the end if the pair separates, else to just before it meets.
-                if flag[c] == 0 and r > reach + eps and abs(e_phi[c]) < 1e-13 and abs(e_om[c]) < 1e-12 and k[c] < n_steps:
-                    skip = _free_flight_steps(d, e_v[c], n_steps - k[c], r - reach - eps, dt)
-                    if skip > 1:
-                        if k[c] < command_step <= k[c] + skip:
-                            armed[c] = 0
-                        e_p[c] += e_v[c] * (skip * dt)
-                        k[c] += skip
-                        r_before[c] = np.nan
-                        continue
-                if couples:
-                    new = coupling.next_flag(flag[c], armed[c], r_before[c], r, d_t, eps, at_crossing)
-                    if new != flag[c]:
-                        if new == 1 and coupled_at[c] < 0:
-                            coupled_at[c] = k[c]
-                        if new == 0 and uncoupled_at[c] < 0:
-                            uncoupled_at[c] = k[c]
-                        flag[c] = new
-                    r_before[c] = r
-                u0 = 0.0
-                if r > 0.0:
-                    u0 = pair_control(function, r, flag[c], params) * (1.0 if d > 0 else -1.0)
-                    u0 = min(max(u0, -c_max), c_max)
-                if k[c] < n_steps:
-                    e_p[c], e_v[c], e_phi[c], e_om[c] = hold_step(ad, bd, e_p[c], e_v[c], e_phi[c], e_om[c], -2.0 * u0)
-                k[c] += 1
-        for lane in range(lanes):
-            e_end[first + lane] = (e_p[lane], e_v[lane], e_phi[lane], e_om[lane])
-            min_dist[first + lane] = lowest[lane]
-            couple_step[first + lane] = coupled_at[lane]
-            uncouple_step[first + lane] = uncoupled_at[lane]
+        _run_block(first, min(LANES, n_cases - first), starts, n_steps, dt, command_step, hold, law, params, box,
+                   ends, min_dist, couple_step, uncouple_step, rule)  # fmt: skip
 
 
 def unsupported(scenario: Scenario) -> str | None:
     """Why ``scenario``'s cases cannot run as a batch, or ``None`` if they can.
 
-    A batch needs the paper's case: one axis, two agents flying from the
-    start without a formation, at most one command (an uncouple).  Only the
-    agents' positions and velocities vary; their tilts and tilt rates start at
-    zero.
+    A batch needs encounters of two agents: two agents listed, flying from
+    level starts (tilts and tilt rates zero), without a formation, in open
+    space on any number of axes, with at most one command (an uncouple), on
+    the linear model.  Only the agents' positions and velocities vary.
 
     Parameters
     ----------
@@ -157,34 +228,36 @@ def unsupported(scenario: Scenario) -> str | None:
         The base scenario of the cases.
     """
     if scenario.model.kind != "linear":
-        return "needs the linear model (2): a batch steps the pair's relative state"
-    if scenario.space.axes != 1 or len(scenario.agents) != 2 or scenario.formation is not None:
-        return "needs a one-axis scenario with two agents listed in [[agents]], without a formation"
+        return "needs the linear model (2), whose exact step the batch takes"
+    if len(scenario.agents) != 2 or scenario.formation is not None:
+        return "needs two agents listed in [[agents]], without a formation"
+    if scenario.space.periodic:
+        return "needs open space: free flight is skipped in closed form, without a box to wrap in"
     if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
         return "at most one command, an uncouple"
-    if any(a.tilt != 0 or a.tilt_rate != 0 or not a.active for a in scenario.agents):
+    if any(not np.all(np.equal(a.tilt, 0)) or not np.all(np.equal(a.tilt_rate, 0)) or not a.active for a in scenario.agents):
         return "the agents must start level (tilt and tilt rate zero) and flying"
-    if scenario.interaction.uncouple_when != "window" or scenario.interaction.synchronise:
-        return "the batch uncouples by the window (9) and does not synchronise"
     return None
 
 
-def _starts(name: str, values, cases: int | None) -> np.ndarray:
-    """``values`` as a float array of shape (cases, 2), finite and bounded as a scenario's; else ValueError."""
+def _starts(name: str, values, cases: int | None, n_axes: int) -> np.ndarray:
+    """``values`` as a float array of shape (cases, 2, axes), finite and bounded as a scenario's; else ValueError."""
+    shape = "(cases, 2)" if n_axes == 1 else f"(cases, 2, {n_axes})"
     try:
         array = np.asarray(values, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"run_batch: {name}: must be numbers, shape (cases, 2) ({exc})") from None
-    if array.ndim != 2 or array.shape[1] != 2 or len(array) == 0:
-        raise ValueError(f"run_batch: {name}: must have shape (cases, 2) with at least one case, got {array.shape}")
+        raise ValueError(f"run_batch: {name}: must be numbers, shape {shape} ({exc})") from None
+    if n_axes == 1 and array.ndim == 2:
+        array = array[:, :, np.newaxis]
+    if array.ndim != 3 or array.shape[1:] != (2, n_axes) or len(array) == 0:
+        raise ValueError(f"run_batch: {name}: must have shape {shape} with at least one case, got {np.shape(values)}")
     if cases is not None and len(array) != cases:
         raise ValueError(f"run_batch: {name}: has {len(array)} cases, positions has {cases}")
     bad = ~np.isfinite(array) | (np.abs(array) > LIMIT)
     if bad.any():
-        case, agent = np.argwhere(bad)[0]
-        raise ValueError(
-            f"run_batch: {name}[{case}, {agent}]: must be a finite number of magnitude at most {LIMIT:g}, got {array[case, agent]}"
-        )
+        where = np.argwhere(bad)[0]
+        at = ", ".join(str(w) for w in (where[:2] if n_axes == 1 else where))
+        raise ValueError(f"run_batch: {name}[{at}]: must be a finite number of magnitude at most {LIMIT:g}, got {array[tuple(where)]}")
     return array
 
 
@@ -194,9 +267,9 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     Parameters
     ----------
     scenario
-        A one-axis, two-agent scenario; everything but the agents' start is
-        shared by all cases.  At most one command, an uncouple of the pair.
-    positions, velocities : ndarray, shape (cases, 2)
+        A scenario of two agents (:func:`unsupported` says what it must be); everything but the
+        agents' start is shared by all cases.
+    positions, velocities : ndarray, shape (cases, 2, axes), or (cases, 2) on one axis
         Each case's start (tilts and tilt rates zero).
 
     Raises
@@ -211,37 +284,45 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     reason = unsupported(scenario)
     if reason:
         raise ValueError(f"run_batch: {reason}")
-    positions = _starts("positions", positions, None)
-    velocities = _starts("velocities", velocities, len(positions))
-    same = np.flatnonzero(positions[:, 0] == positions[:, 1])
+    n_axes = scenario.space.axes
+    positions = _starts("positions", positions, None, n_axes)
+    velocities = _starts("velocities", velocities, len(positions), n_axes)
+    same = np.flatnonzero(np.all(positions[:, 0] == positions[:, 1], axis=1))
     if len(same):
         raise ValueError(
-            f"run_batch: positions[{same[0]}]: both agents at {positions[same[0], 0]}: "
+            f"run_batch: positions[{same[0]}]: both agents at {positions[same[0], 0].tolist() if n_axes > 1 else positions[same[0], 0, 0]}: "
             "two agents at one point have no direction to part in"
         )
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
-    hold = model.step_params(sim.dt)
     linearisation = model.linearisation()
     law, params = law_of(scenario, linearisation, gains_for(*linearisation, c.r_l, c.im_l, c.im_r))
-    cases = len(positions)
-    start = np.zeros((cases, 2, 4))
-    start[:, :, 0] = positions
-    start[:, :, 1] = velocities
-    relative = start[:, 1] - start[:, 0]
-    total = start[:, 1] + start[:, 0]
-    n_steps = sim.n_steps
     command_step = sim.step_of(scenario.commands[0].time) if scenario.commands else -1
-    e_end = np.empty((cases, 4))
+    hold = model.step_params(sim.dt)
+    cases = len(positions)
+    starts = np.zeros((cases, 2, n_axes, 4))
+    starts[..., 0] = positions
+    starts[..., 1] = velocities
     min_dist = np.empty(cases)
     couple_step = np.empty(cases, dtype=np.int64)
     uncouple_step = np.empty(cases, dtype=np.int64)
-    _run_batch(relative, n_steps, sim.dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step)
-    total_end = total @ np.linalg.matrix_power(hold.ad, n_steps).T  # the sum flies free
-    v0 = (total_end[:, 1] - e_end[:, 1]) / 2
-    v1 = (total_end[:, 1] + e_end[:, 1]) / 2
-    rms0 = np.sqrt((velocities**2).mean(axis=1))
-    rms1 = np.sqrt((v0**2 + v1**2) / 2)
+    if n_axes == 1 and law.uncouple_rule == coupling.UNCOUPLE_BY_WINDOW and law.sync_gain == 0.0:
+        relative = starts[:, 1, 0] - starts[:, 0, 0]
+        e_end = np.empty((cases, 4))
+        run_relative(relative, sim.n_steps, sim.dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step)
+        total_end = (starts[:, 1, 0] + starts[:, 0, 0]) @ np.linalg.matrix_power(hold.ad, sim.n_steps).T  # the sum flies free
+        final_velocities = np.stack([(total_end[:, 1] - e_end[:, 1]) / 2, (total_end[:, 1] + e_end[:, 1]) / 2], axis=1)[:, :, None]
+        final_distance = np.abs(e_end[:, 0])
+        rule = np.where(uncouple_step >= 0, coupling.RELEASES.index("window"), -1)
+    else:
+        ends = np.empty_like(starts)
+        rule = np.empty(cases, dtype=np.int64)
+        _run_batch(starts, sim.n_steps, sim.dt, command_step, hold, law, params, (0.0,) * n_axes,
+                   ends, min_dist, couple_step, uncouple_step, rule)  # fmt: skip
+        final_velocities = ends[..., 1]
+        final_distance = np.linalg.norm(ends[:, 1, :, 0] - ends[:, 0, :, 0], axis=1)
+    rms0 = np.sqrt((velocities**2).sum(axis=2).mean(axis=1))
+    rms1 = np.sqrt((final_velocities**2).sum(axis=2).mean(axis=1))
     with np.errstate(invalid="ignore", divide="ignore"):
         change = np.where(rms0 > 0, 100.0 * (rms1 / rms0 - 1.0), np.nan)
     return BatchResult(
@@ -249,8 +330,9 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
         rms_velocity_final=rms1,
         rms_change_percent=change,
         min_distance=min_dist,
-        final_distance=np.abs(e_end[:, 0]),
+        final_distance=final_distance,
         couple_time=np.where(couple_step >= 0, couple_step * sim.dt, np.nan),
         uncouple_time=np.where(uncouple_step >= 0, uncouple_step * sim.dt, np.nan),
-        final_velocities=np.stack([v0, v1], axis=1),
+        uncouple_rule=np.array([coupling.RELEASES[r] if r >= 0 else None for r in rule], dtype=object),
+        final_velocities=final_velocities,
     )

@@ -305,7 +305,8 @@ def coupling_summary(trajectory: Trajectory) -> dict:
     coupling; ``pairs_coupled_at_start`` / ``_ever`` / ``_at_end``: how many
     pairs were so; ``couple_time``: when a pair was first coupled (0 if one
     started coupled); ``uncouple_time``: the first ``uncouple`` event (after an
-    operator's command, or a pair losing an agent).
+    operator's command, or a pair losing an agent), and ``uncouple_rule`` what
+    released it (:data:`tmem.coupling.RELEASES`).
 
     Parameters
     ----------
@@ -321,6 +322,7 @@ def coupling_summary(trajectory: Trajectory) -> dict:
         "pairs_coupled_at_end": int(end.sum()),
         "couple_time": 0.0 if start.any() else _first([e.time for e in events if e.kind == "couple"]),
         "uncouple_time": _first([e.time for e in events if e.kind == "uncouple"]),
+        "uncouple_rule": next((e.rule for e in events if e.kind == "uncouple"), None),  # events are in time order
     }
 
 

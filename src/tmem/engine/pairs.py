@@ -83,11 +83,14 @@ def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
         u[j, a] -= d[a]
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _synchronise(e, r, dist, entering, pushed, known, pairs, law, params, n_axes, u):
     """(S2) on pair ``e``: from its coupling, its relative motion damped and its mean square speed held
     at its value when it came within reach; after it uncouples, the speed alone, until it is out of
-    reach again (:mod:`tmem.synchronise`).  ``pushed``: the pair's push on agent ``i`` this step."""
+    reach again (:mod:`tmem.synchronise`).  ``pushed``: the pair's push on agent ``i`` this step.
+
+    Called, not inlined, and only where a scenario synchronises: inlined in the step loop it made the
+    first run's compilation a third longer for every scenario."""
     i = pairs.i[e]
     j = pairs.j[e]
     if entering:
@@ -105,47 +108,72 @@ def _synchronise(e, r, dist, entering, pushed, known, pairs, law, params, n_axes
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
+def formation_pair(k, e, known, agents, pairs, law, params, box, events, counters):
+    """Formation pair ``e`` at step ``k``: its flag ``F_en`` after this step's check ((9), or the energy
+    match), its smallest distance, its pull or push on both agents, and the synchronisation (S2).
+    A pair whose agent was removed uncouples and rests.  The step loop calls it for every pair
+    (:func:`formation_pairs`), and :mod:`tmem.batch` for each encounter of a batch.
+
+    Called, not inlined: compiled once and shared by the serial and threaded loops and the batch,
+    where each inlined copy of it (with the energy rule and the synchronisation inside) added
+    seconds to the first run's compilation.  It allocates nothing, so it runs without Numba's runtime.
+
+    Parameters
+    ----------
+    k, e : int
+        The step and the pair.
+    known : ndarray, shape (agents, axes, n_state)
+        The states as measured (:func:`tmem.sensing.measure`): the pair's velocities.
+    agents, pairs, law, events, counters
+        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters; each pair's own ``d_t`` replaces the scenario's.
+    box : tuple of float
+        The box sides (0: open axis).
+    """
+    d = pairs.d
+    n_axes = len(box)
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if not (agents.active[i] and agents.active[j]):
+        if pairs.flag[e] == 1:  # the pair is lost with its agent
+            pairs.flag[e] = 0
+            pairs.kept_speed2[e] = np.nan
+            log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1, coupling.RELEASE_LOST)
+        pairs.r_before[e] = np.nan
+        return
+    r, dist = _pair_geometry(agents.corrected, e, pairs, box, d)
+    if dist < pairs.min_distance[e]:
+        pairs.min_distance[e] = dist
+    if law.couples:
+        energy = 0.0  # needed by the energy rule only
+        if law.uncouple_rule == coupling.UNCOUPLE_BY_ENERGY and r > 0.0:
+            energy = coupling.relative_energy(known, i, j, d, r, n_axes)
+        new, released_by = _next_flag(k, e, r, energy, pairs, law, params)
+        if new != pairs.flag[e]:
+            pairs.flag[e] = new
+            log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1, released_by)
+    entering = r < params.reach and not pairs.r_before[e] < params.reach  # or at the first step
+    pairs.r_before[e] = r
+    _pair_pull(e, d, r, pairs, law, params, n_axes, agents.setpoint)
+    if law.sync_gain > 0.0:
+        _synchronise(e, r, dist, entering, d, known, pairs, law, params, n_axes, agents.setpoint)
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def formation_pairs(k, known, agents, pairs, law, params, run, events, counters):
-    """Each formation pair: its flag ``F_en`` after this step's check ((9), or the energy match), its
-    smallest distance, its pull or push on both agents, and, while coupled, the synchronisation (S2).
-    A pair whose agent was removed uncouples and rests.
+    """Every formation pair's step, :func:`formation_pair`, in order.
 
     Parameters
     ----------
     k : int
         The step.
     known : ndarray, shape (agents, axes, n_state)
-        The states as measured (:func:`tmem.sensing.measure`): the pair's relative velocity.
+        The states as measured (:func:`tmem.sensing.measure`).
     agents, pairs, law, run, events, counters
         The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
     params : FunctionParams
-        The interaction functions' parameters; each pair's own ``d_t`` replaces the scenario's.
+        The interaction functions' parameters.
     """
-    d = pairs.d
-    n_axes = len(run.box)
     for e in range(pairs.i.shape[0]):
-        i = pairs.i[e]
-        j = pairs.j[e]
-        if not (agents.active[i] and agents.active[j]):
-            if pairs.flag[e] == 1:  # the pair is lost with its agent
-                pairs.flag[e] = 0
-                pairs.kept_speed2[e] = np.nan
-                log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1, coupling.RELEASE_LOST)
-            pairs.r_before[e] = np.nan
-            continue
-        r, dist = _pair_geometry(agents.corrected, e, pairs, run.box, d)
-        if dist < pairs.min_distance[e]:
-            pairs.min_distance[e] = dist
-        if law.couples:
-            energy = 0.0  # needed by the energy rule only
-            if law.uncouple_rule == coupling.UNCOUPLE_BY_ENERGY and r > 0.0:
-                energy = coupling.relative_energy(known, i, j, d, r, n_axes)
-            new, released_by = _next_flag(k, e, r, energy, pairs, law, params)
-            if new != pairs.flag[e]:
-                pairs.flag[e] = new
-                log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1, released_by)
-        entering = r < params.reach and not pairs.r_before[e] < params.reach  # or at the first step
-        pairs.r_before[e] = r
-        _pair_pull(e, d, r, pairs, law, params, n_axes, agents.setpoint)
-        if law.sync_gain > 0.0:
-            _synchronise(e, r, dist, entering, d, known, pairs, law, params, n_axes, agents.setpoint)
+        formation_pair(k, e, known, agents, pairs, law, params, run.box, events, counters)

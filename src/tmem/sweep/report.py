@@ -27,8 +27,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from ..coupling import RELEASES  # noqa: E402
 from ..outputs import write_atomically  # noqa: E402
-from .spec import Sweep  # noqa: E402
+from .spec import DISTRIBUTIONS, Sweep  # noqa: E402
 
 RMS = "rms_change_percent"
 PERCENTILES = (5, 25, 75, 95)
@@ -126,7 +127,7 @@ def _describe_varied(sweep: Sweep) -> list[str]:
     spec = sweep.spec
     rows = [[f"`{p}`", "grid", ", ".join(map(str, v))] for p, v in spec.grid.items()]
     for path, dist in spec.random.items():
-        kind = next(k for k in ("uniform", "loguniform", "normal", "choice") if getattr(dist, k) is not None)
+        kind = next(k for k in DISTRIBUTIONS if getattr(dist, k) is not None)
         rows.append([f"`{path}`", f"random, {kind}", ", ".join(map(str, getattr(dist, kind)))])
     for path in sweep.parameters:
         if path not in spec.grid and path not in spec.random:
@@ -160,6 +161,17 @@ def _coupling_section(groups: list[tuple[str, pd.DataFrame]], command_time: floa
     return ["## Coupling", "", *_markdown_table(header, rows), "", note, ""]
 
 
+def _rule_section(groups: list[tuple[str, pd.DataFrame]]) -> list[str]:
+    """What released the pairs that uncoupled, by setting (:data:`tmem.coupling.RELEASES`)."""
+    rows = []
+    for label, group in groups:
+        rules = group.loc[group["error"].isna(), "uncouple_rule"].dropna()
+        shares = rules.value_counts(normalize=True)
+        rows.append([label, str(len(rules)), *(_cell(100.0 * shares.get(rule, 0.0), "{:.1f}") for rule in RELEASES)])
+    header = ["setting", "uncoupled", *(f"by `{rule}` (%)" for rule in RELEASES)]
+    return ["## What released the pairs", "", *_markdown_table(header, rows), ""]
+
+
 def _other_section(groups: list[tuple[str, pd.DataFrame]], metrics: list[str]) -> list[str]:
     rows = []
     for metric in metrics:
@@ -186,8 +198,8 @@ def _figures(groups: list[tuple[str, pd.DataFrame]], table: pd.DataFrame, sweep:
     names.append("rms_change_histogram.png")
     for path in sweep.parameters:
         values = pd.to_numeric(table[path], errors="coerce")
-        if values.isna().all() or values.nunique() < 2:
-            continue
+        if values.isna().all() or values.nunique() < 2 or table[path].map(lambda v: isinstance(v, bool)).any():
+            continue  # nothing to draw against, or settings rather than a scale
         fig, ax = plt.subplots(figsize=(7, 4))
         for label, group in groups:
             ok = group["error"].isna()
@@ -239,7 +251,9 @@ def write_report(table: pd.DataFrame, sweep: Sweep, out: str | Path) -> Path:
         lines += _rms_section(groups)
     if "coupled" in metrics or "couple_time" in metrics:
         lines += _coupling_section(groups, uncouple_command_time(sweep))
-    others = [m for m in metrics if m not in (RMS, "coupled", "couple_time", "uncouple_time")]
+    if "uncouple_rule" in metrics:
+        lines += _rule_section(groups)
+    others = [m for m in metrics if m not in (RMS, "coupled", "couple_time", "uncouple_time", "uncouple_rule")]
     if others:
         lines += _other_section(groups, others)
     if RMS in metrics and len(table) > len(failed):

@@ -15,8 +15,9 @@ A sweep file is TOML::
     [grid]                   # every combination of these lists
     "interaction.function" = ["switching", "improved"]
 
-    [random]                 # drawn per case: uniform, loguniform, normal or choice
+    [random]                 # drawn per case: uniform, loguniform, normal, choice or polar
     "agents.1.position" = { uniform = [45, 80] }
+    "agents.0.velocity" = { polar = [[1, 5], [150, 210]] }   # 2-D: length 1-5, direction 150-210 degrees
 
     [[case]]                 # explicit cases, each a table of changes (optional)
     "interaction.c_max" = 0.05
@@ -45,7 +46,7 @@ import re
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 from pydantic import Field, ValidationError, model_validator
@@ -75,7 +76,10 @@ SCALAR_METRICS = (
     "coupled",
     "couple_time",
     "uncouple_time",
+    "uncouple_rule",
 )
+#: The column type of a metric that is not a number.
+METRIC_TYPES = {"coupled": "boolean", "uncouple_rule": "string"}
 _PAIR_KEYS = (
     "coupled_at|uncoupled_at|separated_at|min_distance|final_distance|mean_distance_coupled"
     "|oscillation_amplitude|distance_error\\.(mean|rms|max)"
@@ -102,19 +106,35 @@ def _kind(value: Any) -> str:
     return "lists or tables"
 
 
+#: The kinds of :class:`Distribution`.
+DISTRIBUTIONS = ("uniform", "loguniform", "normal", "choice", "polar")
+
+
 class Distribution(StrictModel):
-    """How one parameter is drawn: exactly one of the four kinds."""
+    """How one parameter is drawn: exactly one of the kinds of :data:`DISTRIBUTIONS`.
+
+    ``polar = [[low, high], [from, to]]`` draws a vector in the plane, ``[L cos a, L sin a]``, of
+    length ``L`` uniform in ``[low, high]`` and direction ``a`` uniform in ``[from, to]`` degrees:
+    a start at a random bearing, or a velocity with a random heading.
+    """
 
     uniform: list[Number] | None = Field(None, min_length=2, max_length=2)
     loguniform: list[Number] | None = Field(None, min_length=2, max_length=2)
     normal: list[Number] | None = Field(None, min_length=2, max_length=2)
     choice: list[Any] | None = Field(None, min_length=1)
+    polar: list[Annotated[list[Number], Field(min_length=2, max_length=2)]] | None = Field(None, min_length=2, max_length=2)
 
     @model_validator(mode="after")
     def _one_kind(self) -> "Distribution":
-        given = [k for k in ("uniform", "loguniform", "normal", "choice") if getattr(self, k) is not None]
+        given = [k for k in DISTRIBUTIONS if getattr(self, k) is not None]
         if len(given) != 1:
-            raise FieldError("", "give exactly one of uniform, loguniform, normal, choice")
+            raise FieldError("", f"give exactly one of {', '.join(DISTRIBUTIONS)}")
+        if self.polar is not None:
+            (low, high), (start, end) = self.polar
+            if not 0 <= low <= high:
+                raise FieldError("polar", f"the lengths must have 0 <= low <= high, got [{low}, {high}]")
+            if start > end:
+                raise FieldError("polar", f"the directions must have from <= to, got [{start}, {end}]")
         for kind in ("uniform", "loguniform"):
             bounds = getattr(self, kind)
             if bounds is not None and bounds[0] > bounds[1]:
@@ -146,6 +166,10 @@ class Distribution(StrictModel):
             return np.exp(rng.uniform(low, high, size=n)).tolist()
         if self.normal is not None:
             return rng.normal(*self.normal, size=n).tolist()
+        if self.polar is not None:
+            length = rng.uniform(*self.polar[0], size=n)
+            angle = np.radians(rng.uniform(*self.polar[1], size=n))
+            return np.stack([length * np.cos(angle), length * np.sin(angle)], axis=1).tolist()
         return [self.choice[i] for i in rng.integers(len(self.choice), size=n)]
 
 

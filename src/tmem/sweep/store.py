@@ -52,7 +52,7 @@ from ..outputs import (
     remove_leftovers,
     write_atomically,
 )
-from .spec import Sweep
+from .spec import METRIC_TYPES, Sweep
 
 RESULTS = "results.parquet"
 PARTS = "parts"
@@ -217,10 +217,12 @@ class ResultStore:
         """Rows as a table with the same column types in every part."""
         frame = pd.DataFrame(rows)
         for column in self.sweep.parameters:
+            if column not in frame:  # set by other explicit cases than these
+                frame[column] = None
             if frame[column].map(lambda v: isinstance(v, list | dict)).any():
                 frame[column] = frame[column].map(json.dumps)  # a vector value, as JSON text
         for metric in self.metrics:
-            frame[metric] = frame[metric].astype("boolean" if metric == "coupled" else "float64")
+            frame[metric] = frame[metric].astype(METRIC_TYPES.get(metric, "float64"))
         frame["error"] = frame["error"].astype("string")
         return frame
 

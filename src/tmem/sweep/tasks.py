@@ -156,9 +156,9 @@ def _run_as_batch(scenario: Scenario, cases: list[Case], starts: np.ndarray, met
     return rows
 
 
-def _python(value: np.generic) -> Any:
+def _python(value: Any) -> Any:
     """A batch figure as ``summary.json`` has it: NaN (an event that did not happen) as None."""
-    value = value.item()
+    value = value.item() if isinstance(value, np.generic) else value
     return None if isinstance(value, float) and math.isnan(value) else value
 
 
