@@ -67,7 +67,7 @@ def _uncoupling(summary: dict) -> str:
     released = [e for e in summary["events"] if e["kind"] == "uncouple"]
     if not released:
         return "not uncoupled"
-    return f"{released[0]['time']:.2f} s, {released[0].get('rule', 'window')}"
+    return f"{released[0]['time']:.2f} s, {released[0]['rule']}"
 
 
 def _metres(value: float | None) -> str:
