@@ -37,6 +37,7 @@ def made(distance, flag, events, velocities=None):
         final_active=np.ones(2, dtype=bool),
         events=events,
         list_builds=0,
+        gas=np.zeros((n, 0)),
     )
 
 

@@ -44,6 +44,7 @@ from PIL import Image
 
 from . import __version__
 from .outputs import ANIMATE_MARK, check_file, replace_file
+from .plot import draw_region
 
 #: Most agents drawn; larger runs are thinned evenly to this many.
 MAX_AGENTS_DRAWN = 3000
@@ -75,6 +76,8 @@ class _Run:
     d_t: np.ndarray  # (edge,): set distance, NaN when not known
     radius: float
     name: str
+    box: list | None  # the walled box's sides, None without walls
+    obstacles: list  # (center, radius) of each obstacle
 
 
 def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -176,6 +179,8 @@ def _read(path: Path, max_frames: int) -> _Run:
             d_t=d_t,
             radius=radius,
             name=str(scenario.get("name", "")),
+            box=scenario["space"]["box"] if scenario.get("space", {}).get("walls") else None,
+            obstacles=[(o["center"], o["radius"]) for o in scenario.get("obstacles", [])],
         )
 
 
@@ -243,11 +248,14 @@ def _figure(run: _Run, shown: np.ndarray, dpi: int) -> tuple[Figure, dict]:
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     seen = shown[np.isfinite(shown).all(axis=-1)]
+    if run.box is not None:  # the whole walled box
+        seen = np.concatenate([seen, [[0.0, 0.0], run.box]])
     low, high = (seen.min(axis=0), seen.max(axis=0)) if len(seen) else (np.zeros(2), np.zeros(2))
     margin = max(run.radius, 0.02 * (high - low).max())  # R, or enough that no dot is cut at the edge
     ax.set(xlim=(low[0] - margin, high[0] + margin), ylim=(low[1] - margin, high[1] + margin))
     ax.set(aspect="equal", xlabel="x, m", ylabel="y, m")
     ax.grid(alpha=0.3)
+    draw_region(ax, run.box, run.box is not None, run.obstacles)
     n_drawn = shown.shape[1]
     title = f"{run.name + ': ' if run.name else ''}{n_drawn} agents drawn, R = {run.radius:g} m"
     ax.set_title(title, parse_math=False)  # the name as written: a ``$`` is not mathtext

@@ -65,6 +65,10 @@ def _listed_agents(scenario: Scenario, axes: int) -> tuple[np.ndarray, np.ndarra
 def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
     """Agents uniform in the region, numbered in cell order.
 
+    In a walled box the region lies inside the walls' reach ``R + R_w`` (by default it is the box
+    less that reach on every side), and no agent starts within that reach of an obstacle: no agent
+    starts already pushed by a wall it may be flying into.
+
     The agents are numbered cell by cell over a grid of side ``R + R_j``
     (last axis slowest), so that neighbours have nearby numbers: recorded
     subsets (``record_agents``) then pick out patches, not scattered agents.
@@ -72,13 +76,26 @@ def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
     """
     swarm = scenario.swarm
     rng = np.random.default_rng(swarm.seed)
-    region = np.asarray(swarm.region or scenario.space.box, dtype=float)
+    inset = scenario.wall_reach if scenario.space.walls else 0.0
+    region = np.asarray(swarm.region or np.asarray(scenario.space.box) - 2.0 * inset, dtype=float)
     state = np.zeros((swarm.n, axes, 4))
-    state[:, :, 0] = rng.uniform(0.0, 1.0, (swarm.n, axes)) * region
+    state[:, :, 0] = inset + rng.uniform(0.0, 1.0, (swarm.n, axes)) * region
+    # Agents within reach of an obstacle are drawn again until clear of every one (the obstacles
+    # cover at most half the region: Scenario checks it).
+    while len(near := np.flatnonzero(_near_obstacle(state[:, :, 0], scenario.obstacles, scenario.wall_reach))):
+        state[near, :, 0] = inset + rng.uniform(0.0, 1.0, (len(near), axes)) * region
     # Each velocity component normal with variance speed_rms^2 / axes: E|v|^2 = speed_rms^2.
     state[:, :, 1] = rng.normal(0.0, swarm.speed_rms / np.sqrt(axes), (swarm.n, axes))
     cells = np.floor(state[:, :, 0] / scenario.interaction.reach).astype(np.int64)
     return state[np.lexsort(cells.T)]
+
+
+def _near_obstacle(positions: np.ndarray, obstacles, reach: float) -> np.ndarray:
+    """Whether each position lies within ``reach`` of an obstacle (or inside it)."""
+    near = np.zeros(len(positions), dtype=bool)
+    for obstacle in obstacles:
+        near |= np.linalg.norm(positions - np.asarray(obstacle.center), axis=1) < obstacle.radius + reach
+    return near
 
 
 def build(scenario: Scenario) -> InitialArrays:

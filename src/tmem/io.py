@@ -22,6 +22,7 @@ import numpy as np
 
 from . import __version__, metrics, plot
 from .engine import Trajectory
+from .engine.gas import COLUMNS
 from .outputs import OutputError, check_directory, replace_directory
 
 __all__ = ["OutputError", "check_output_directory", "contents", "to_dataset", "write_netcdf", "write_run", "write_run_files"]
@@ -49,7 +50,9 @@ def contents(trajectory: Trajectory) -> Contents:
     model's state names) and the control ``U`` over (time, agent, axis);
     ``active`` over (time, agent); the coupling flag ``F_en``, the distance and
     the interaction distance ``|d|`` (6) over (time, pair); each pair's set
-    distance ``d_t``; the RMS velocity of the recorded agents over time.  Units
+    distance ``d_t``; the RMS velocity of the recorded agents over time; when
+    the gas is observed, its running totals ``gas_*`` over time
+    (:data:`tmem.engine.gas.COLUMNS`; :mod:`tmem.observables` reads them).  Units
     are in each variable's attributes; the scenario (as TOML), the gains and the
     events are in the file's attributes.
 
@@ -88,6 +91,9 @@ def contents(trajectory: Trajectory) -> Contents:
         metrics.rms_velocity(model.velocity(trajectory.state), trajectory.active),
         {"long_name": "RMS velocity over the recorded agents flying", "units": "m s-1"},
     )
+    if trajectory.gas.shape[1]:
+        for c, (name, (long_name, units)) in enumerate(COLUMNS.items()):
+            data[f"gas_{name}"] = (("time",), trajectory.gas[:, c], {"long_name": long_name, "units": units})
     attrs = {
         "title": f"tmem run {trajectory.scenario.name}".strip(),
         "source": f"tmem {__version__}",

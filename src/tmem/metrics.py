@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from .engine import Event, Trajectory
+from .coverage import coverage_summary
+from .observables import gas_summary
 
 
 def rms_velocity(velocity: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
@@ -330,7 +332,9 @@ def summarize(trajectory: Trajectory) -> dict:
     """The run's summary, as written to ``summary.json``.
 
     The RMS velocity and its change: :func:`rms_summary`; coupling:
-    :func:`coupling_summary`.  ``min_distance`` is the smallest distance two
+    :func:`coupling_summary`; the gas's observables (when observed):
+    :func:`tmem.observables.gas_summary`; the coverage of a walled box:
+    :func:`tmem.coverage.coverage_summary`.  ``min_distance`` is the smallest distance two
     agents reached at any step (formation pairs always; other pairs once within
     ``R + R_j``); ``final_distance`` the smallest distance between two flying
     agents at the end.  Every number is finite: ``None`` (JSON ``null``) stands
@@ -361,5 +365,7 @@ def summarize(trajectory: Trajectory) -> dict:
         "events": summarize_events(trajectory.events),
         "gains": trajectory.gains.tolist(),
         "formation": formation_summary(trajectory),
+        "gas": gas_summary(trajectory),
+        "coverage": coverage_summary(trajectory),
         "pairs": [pair_summary(trajectory, p) for p in range(len(trajectory.pairs))],
     }

@@ -4,7 +4,10 @@
 RMS velocity against time.  ``distance.png``: pair distances against time
 with ``R + R_j`` and ``d_t`` marked and the coupling events, above the flags
 ``F_en``.  ``formation.png`` (formations only): the distance error of the
-formation's pairs against time.
+formation's pairs against time.  ``gas.png`` (runs that observe their gas):
+the RMS velocity of every flying agent and the thermostat's set-point against
+time.  ``field.png`` (2-D walled boxes): the coverage map, with the walls and
+obstacles (:mod:`tmem.coverage`).
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from matplotlib.figure import Figure  # not pyplot: writing a file needs no wind
 
 from . import metrics
 from .engine import Trajectory
+from .observables import temperature
 
 #: Matplotlib's warning for a character its font lacks (a name in CJK, an emoji).
 MISSING_GLYPH = r"Glyph \d+ .* missing from font"
@@ -129,10 +133,80 @@ def formation_figure(trajectory: Trajectory):
     return fig
 
 
-def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
-    """Write ``velocity.png`` (if agents were recorded), ``distance.png`` (if pairs) and ``formation.png``.
+def draw_region(ax, box, walls: bool, obstacles) -> None:
+    """Draw the walls of a 2-D box (from 0 to ``box``) and the obstacles' circles on ``ax``.
 
-    ``formation.png`` only for a scenario with a formation.
+    Parameters
+    ----------
+    ax : matplotlib Axes
+    box : sequence of float or None
+        The box's sides (m).
+    walls : bool
+        Whether the box is walled (else nothing is drawn of it).
+    obstacles : sequence of (center, radius)
+        The obstacles (m).
+    """
+    from matplotlib.patches import Circle, Rectangle
+
+    if walls and box is not None:
+        ax.add_patch(Rectangle((0.0, 0.0), box[0], box[1], fill=False, edgecolor="k", linewidth=1.5))
+    for center, radius in obstacles:
+        ax.add_patch(Circle(tuple(center[:2]), radius, facecolor="0.6", edgecolor="k", linewidth=1.0))
+
+
+def gas_figure(trajectory: Trajectory):
+    """The RMS velocity of every flying agent against time, and the thermostat's set-point.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run that observed its gas.
+    """
+    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(trajectory.time, temperature(trajectory), color="k", linewidth=1.5, label="RMS velocity, all agents")
+    scenario = trajectory.scenario
+    settings = [(0.0, scenario.thermostat.rms_velocity if scenario.thermostat else None)]
+    settings += [(c.time, c.value) for c in sorted(scenario.commands, key=lambda c: c.time) if c.action == "temperature"]
+    if any(value is not None for _, value in settings):
+        steps = [(t, v if v is not None else np.nan) for t, v in settings] + [(trajectory.time[-1], np.nan)]
+        times = [t for t, _ in steps]
+        values = [v for _, v in steps[:-1]] + [steps[-2][1]]
+        ax.step(times, values, where="post", color="tab:red", linestyle="--", label="set-point")
+    _mark_events(ax, trajectory)
+    ax.set_xlabel("time, s")
+    ax.set_ylabel("RMS velocity, m/s")
+    ax.set_title(_title(trajectory), parse_math=False)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    return fig
+
+
+def field_figure(trajectory: Trajectory):
+    """The coverage map of a 2-D walled box: when each cell was first visited, the walls, the obstacles.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A 2-D run in a walled box.
+    """
+    from .coverage import plot_coverage, run_coverage
+
+    found = run_coverage(trajectory)
+    scenario = trajectory.scenario
+    obstacles = [(o.center, o.radius) for o in scenario.obstacles]
+    title = f"{_title(trajectory)}\n{100 * found.share[-1]:.1f} % of the field covered"
+    fig = plot_coverage(found, obstacles=obstacles, title=title)
+    draw_region(fig.axes[0], scenario.space.box, True, ())
+    return fig
+
+
+def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
+    """Write ``velocity.png`` (if agents were recorded), ``distance.png`` (if pairs), ``formation.png``,
+    ``gas.png`` and ``field.png``.
+
+    ``formation.png`` only for a scenario with a formation; ``gas.png`` for a run that observed its
+    gas; ``field.png`` for a 2-D walled box.
 
     Parameters
     ----------
@@ -153,6 +227,10 @@ def write_figures(trajectory: Trajectory, directory: Path) -> list[Path]:
         makers.append(("distance.png", distance_figure))
     if trajectory.scenario.formation is not None and len(trajectory.pairs):
         makers.append(("formation.png", formation_figure))
+    if trajectory.gas.shape[1]:
+        makers.append(("gas.png", gas_figure))
+    if trajectory.scenario.space.walls and trajectory.scenario.space.axes == 2 and trajectory.state.shape[1]:
+        makers.append(("field.png", field_figure))
     paths = []
     if not len(trajectory.time):
         return paths

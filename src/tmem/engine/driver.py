@@ -30,8 +30,9 @@ from ..sensing import Sensing, exact
 from ..synchronise import coupled_mode, synchronising_gain
 from .loop import advance_for
 from .stages import CHUNK
+from .gas import SNAPSHOT, TOTALS, gas_record, wall_params
 from .records import (
-    COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Law, Neighbours, Pairs, Records, Run,
+    COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Gas, Law, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
 from .trajectory import DIVERGED, Event, SimulationError, Trajectory
 
@@ -115,7 +116,8 @@ def _commands(scenario: Scenario, edges: np.ndarray, slot: np.ndarray) -> Comman
             targets.append([index[(min(i, j), max(i, j))] for i, j in cmd.targets or []])
     ptr = np.cumsum([0] + [len(t) for t in targets]).astype(np.int64)
     flat = np.array([t for row in targets for t in row], dtype=np.int64)
-    return Commands(step, kind, ptr, flat)
+    value = np.array([np.nan if cmd.value is None else cmd.value for cmd in commands], dtype=float)
+    return Commands(step, kind, ptr, flat, value)
 
 
 def _partners(n_agents: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -163,7 +165,8 @@ class _NeighbourLister:
                           self.block_shift2, self.closest, self.chunks)  # fmt: skip
 
 
-def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int) -> Records:
+def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int,
+             observe: bool) -> Records:
     rows = n_steps_recorded
     return Records(
         slots=slots,
@@ -173,6 +176,7 @@ def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n
         flag=np.empty((rows, n_edges), dtype=np.int64),
         distance=np.empty((rows, n_edges)),
         measure=np.empty((rows, n_edges)),
+        gas=np.zeros((rows, len(TOTALS) + len(SNAPSHOT) if observe else 0)),
     )
 
 
@@ -229,7 +233,7 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
     recorded = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
     recorded = recorded if record else recorded[:0]
-    records = _records(len(steps), recorded, slot[recorded], n_axes, n_state, n_edges)
+    records = _records(len(steps), recorded, slot[recorded], n_axes, n_state, n_edges, scenario.gas_observed)
     # A pair changes flag at most once before any command and twice after each.
     events = _events(n_edges * (1 + 2 * len(commands.step)) + len(commands.step))
     return _Slots(order, slot, agents, pairs, commands, records, events, Counters.zero(), recorded, steps)
@@ -279,7 +283,9 @@ def simulate(
     lister.p_ref[:] = interaction_point(x, gains)  # P* (6) at the start
     advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM)
     sensing = exact(x) if sensing is None else sensing
-    _drive(advance, run, law, params, model.step_params(sim.dt), sensing, swarm, lister, progress, chunk_seconds)
+    gas = gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0])
+    stages = (law, params, model.step_params(sim.dt), sensing, gas, wall_params(params, gas.wall_reach))
+    _drive(advance, run, stages, swarm, lister, progress, chunk_seconds)
     if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
     return Trajectory(
@@ -301,6 +307,7 @@ def simulate(
         final_active=swarm.agents.active[swarm.slot],
         events=_read_events(swarm.events, int(swarm.counters.n_events[0]), swarm.order, sim.dt),
         list_builds=lister.builds,
+        gas=swarm.records.gas,
     )
 
 
@@ -314,10 +321,11 @@ def _run_of(scenario: Scenario, initial: InitialArrays, record: bool) -> Run:
     return Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
 
 
-def _drive(advance, run: Run, law: Law, params, vehicle, sensing: Sensing, swarm: _Slots, lister: _NeighbourLister,
-           progress, chunk_seconds: float) -> None:
+def _drive(advance, run: Run, stages: tuple, swarm: _Slots, lister: _NeighbourLister, progress, chunk_seconds: float) -> None:
     """Run the compiled loop ``advance`` over every step, in chunks of about ``chunk_seconds``,
-    listing the neighbours again whenever the loop asks."""
+    listing the neighbours again whenever the loop asks.  ``stages`` are the records of the law and
+    the stages: ``(law, params, vehicle, sensing, gas, wall_params)``."""
+    law, params, vehicle, sensing, gas, walls = stages
     neighbours = lister.list(swarm.agents.active, run.box)
     counters = swarm.counters
     chunk = 1000
@@ -325,7 +333,7 @@ def _drive(advance, run: Run, law: Law, params, vehicle, sensing: Sensing, swarm
         started = _time.perf_counter()
         stop = min(counters.step[0] + chunk, run.n_steps + 1)
         status = advance(stop, run, law, params, vehicle, sensing, swarm.agents, swarm.pairs, neighbours, swarm.commands,
-                         swarm.records, swarm.events, counters)  # fmt: skip
+                         swarm.records, swarm.events, counters, gas, walls)  # fmt: skip
         if status == LISTS_STALE:
             neighbours = lister.list(swarm.agents.active, run.box)  # and go on from the same step
             continue

@@ -31,6 +31,7 @@ from ..space import into_box
 from ..sensing import measure
 from .records import DONE, LISTS_STALE
 from ..control import tilt_scale
+from .gas import gas_pushes, tally, tilt_limit
 from .pairs import formation_pairs
 from .stages import apply_commands, commands_due, corrected_positions, is_recorded, neighbour_pushes, record
 
@@ -46,13 +47,15 @@ def vehicle_step(x, u, i, scale, params, n_axes):
     raise NotImplementedError("the step loop is compiled by advance_for, which binds the vehicle model's step")
 
 
-def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, neighbours, commands, records, events, counters):
+def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, neighbours, commands, records, events, counters,
+                    gas, wall_params):
     """Advance from step ``counters.step`` to ``k_stop``; return ``DONE``, or ``LISTS_STALE`` when the
     neighbour lists must be built before the step ``counters.step`` (the caller builds them from
     ``neighbours.p_ref`` and calls again).
 
-    Each step: commands -> measurement -> P* (6) -> neighbour pushes -> formation pairs ->
-    record -> saturate the set-point and step the vehicles (held over ``dt``)."""
+    Each step: commands -> measurement -> P* (6) -> neighbour pushes -> formation pairs -> thermostat,
+    walls and obstacles (when the gas is observed) -> record -> saturate the set-point and step the
+    vehicles (held over ``dt``)."""
     box = run.box
     n_axes = len(box)
     c_max = params.c_max
@@ -61,25 +64,30 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     active = agents.active
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
-        rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters)
+        rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters, gas)
         known = measure(x, sensing)
-        moved2 = corrected_positions(known, agents, law, run, neighbours)
+        moved2 = corrected_positions(known, agents, law, run, neighbours, gas)
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
             for i in range(x.shape[0]):
                 for a in range(n_axes):
                     neighbours.p_ref[i, a] = agents.corrected[i, a, 0]
             return LISTS_STALE
-        neighbour_pushes(agents, neighbours, law, params, run)
-        formation_pairs(k, known, agents, pairs, law, params, run, events, counters)
+        neighbour_pushes(agents, neighbours, law, params, run, gas)
+        formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas)
+        if gas.observe:
+            gas_pushes(known, agents, gas, wall_params, run)
         if is_recorded(k, run):
-            record(agents, pairs, records, c_max, run, counters)
+            record(agents, pairs, records, c_max, run, counters, gas)
         if k < run.n_steps:
             for i in numba.prange(x.shape[0]):
                 if active[i]:
-                    vehicle_step(x, u, i, tilt_scale(u, i, n_axes, c_max), vehicle, n_axes)
+                    scale = tilt_scale(u, i, n_axes, tilt_limit(gas, i, c_max))
+                    vehicle_step(x, u, i, scale, vehicle, n_axes)
                     for a in range(n_axes):
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
                             x[i, a, 0] = into_box(x[i, a, 0], box[a])
+                    if gas.observe:
+                        tally(x, i, scale, gas, n_axes)
     counters.step[0] = k_stop
     return DONE
 

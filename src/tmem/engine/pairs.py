@@ -161,8 +161,44 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def formation_pairs(k, known, agents, pairs, law, params, run, events, counters):
-    """Every formation pair's step, :func:`formation_pair`, in order.
+def _count_pair(e, agents, pairs, law, params, box, gas):
+    """For the gas (:mod:`tmem.engine.gas`): pair ``e``, if within reach, counted as the neighbour
+    stage counts its pairs; with no coupling flag (the tracked pairs of a small swarm) it is a plain
+    neighbour, and the mean of pushes (C1) divides its push too.  ``pairs.d`` holds its push on ``i``."""
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if not (agents.active[i] and agents.active[j]) or not pairs.r_before[e] < params.reach:
+        return
+    n_axes = len(box)
+    d = pairs.d
+    size2 = 0.0
+    for a in range(n_axes):
+        size2 += d[a] * d[a]
+    pressing = np.sqrt(size2) / params.c_max
+    if gas.mean and not law.couples:
+        share = 1.0 / max(1.0, gas.crowd[i], gas.crowd[j])
+        if share < 1.0:
+            for a in range(n_axes):
+                agents.setpoint[i, a] -= (1.0 - share) * d[a]
+                agents.setpoint[j, a] += (1.0 - share) * d[a]
+                d[a] *= share
+    virial = 0.0
+    for a in range(n_axes):
+        virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
+    gas.contact[i] += pressing
+    gas.contact[j] += pressing
+    gas.near[i] += 1.0
+    gas.near[j] += 1.0
+    gas.near_energy[i] += gas.energy[j]
+    gas.near_energy[j] += gas.energy[i]
+    gas.virial[i] += virial
+    gas.virial[j] += virial
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas):
+    """Every formation pair's step, :func:`formation_pair`, in order; counted for the gas when it is
+    observed (:func:`_count_pair`).
 
     Parameters
     ----------
@@ -170,10 +206,13 @@ def formation_pairs(k, known, agents, pairs, law, params, run, events, counters)
         The step.
     known : ndarray, shape (agents, axes, n_state)
         The states as measured (:func:`tmem.sensing.measure`).
-    agents, pairs, law, run, events, counters
-        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
+    agents, pairs, law, run, events, counters, gas
+        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events``,
+        ``counters`` and ``gas`` change in place.
     params : FunctionParams
         The interaction functions' parameters.
     """
     for e in range(pairs.i.shape[0]):
         formation_pair(k, e, known, agents, pairs, law, params, run.box, events, counters)
+        if gas.observe:
+            _count_pair(e, agents, pairs, law, params, run.box, gas)

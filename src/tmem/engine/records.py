@@ -17,8 +17,8 @@ from typing import NamedTuple
 import numpy as np
 
 #: Command kinds, in the order of their integer codes.
-COMMANDS = ("uncouple", "couple", "remove", "add")
-UNCOUPLE, COUPLE, REMOVE, ADD = range(4)
+COMMANDS = ("uncouple", "couple", "remove", "add", "temperature")
+UNCOUPLE, COUPLE, REMOVE, ADD, TEMPERATURE = range(5)
 #: What a chunk of the loop returns: it ran to its end, or the neighbour lists must be built first.
 DONE, LISTS_STALE = 0, -1
 
@@ -201,17 +201,20 @@ class Commands(NamedTuple):
     """The operator's commands, sorted by step; command ``c`` acts on ``target[ptr[c]:ptr[c + 1]]``.
 
     ``target`` holds pair indices for couple / uncouple (none: every pair) and
-    the agent's slot for remove / add.
+    the agent's slot for remove / add; ``value`` the set RMS velocity of a
+    temperature command (m/s; NaN for the others).
     """
 
     step: np.ndarray
     kind: np.ndarray
     ptr: np.ndarray
     target: np.ndarray
+    value: np.ndarray
 
 
 class Records(NamedTuple):
-    """What is recorded at each recorded step, for the agents in ``slots`` and every pair."""
+    """What is recorded at each recorded step, for the agents in ``slots`` and every pair; ``gas``
+    the swarm's totals (:data:`tmem.engine.gas.TOTALS`, no columns when the gas is not observed)."""
 
     slots: np.ndarray
     state: np.ndarray
@@ -220,6 +223,84 @@ class Records(NamedTuple):
     flag: np.ndarray
     distance: np.ndarray
     measure: np.ndarray
+    gas: np.ndarray
+
+
+class Gas(NamedTuple):
+    """The swarm as a gas (:mod:`tmem.engine.gas`): how pushes combine, the thermostat, the walls and
+    obstacles, and the running totals its observables come from.
+
+    Attributes
+    ----------
+    observe : bool
+        Count neighbours and keep the totals: on when any option below is, or when asked.
+    mean : bool
+        ``interaction.combine == "mean"``: pushes divided by the number of contacts (C1).
+    rate : float
+        ``1 / (2 tau)`` of the thermostat (T1) (1/s); 0: no thermostat.
+    target2 : ndarray, shape (1,)
+        The set mean square speed (m^2/s^2); 0: the thermostat waits for a command.
+    inv_g : float
+        ``1 / g``: a wanted acceleration (m/s^2) as a tilt (rad).
+    g_dt : float
+        ``g dt``: a tilt (rad) held over a step as a change of velocity (m/s).
+    dt : float
+        The step (s).
+    walls : ndarray, shape (axes,)
+        Sides of the walled box, from 0 to ``walls[a]`` on axis ``a`` (0: no walls on that axis).
+    obstacles : ndarray, shape (obstacles, axes + 1)
+        Centre and radius of each circle (sphere in 3-D).
+    wall_reach : float
+        ``R + R_w`` (m): a wall or obstacle pushes an agent whose ``P*`` is closer to it than that.
+    near, near_energy, speed2, virial, wall_push, wall_moment : ndarray, shape (agents,) (empty when not observed)
+        Work space of a step: neighbours within reach, the sum of their energies, the agent's own
+        ``|V|^2``, its virial (rad m: in a walled box ``(P_i - c) . u_i`` over every push but the
+        walls', ``c`` the box's centre; else half of ``sum_j (P_i - P_j) . u_ij`` over its
+        neighbours), the size of the box walls' pushes (rad) and their sum weighted by the agent's
+        distance from each wall (rad m).
+    contact : ndarray, shape (agents,)
+        Work space: the sizes of this step's pushes of neighbours in units of ``c_max``.
+    crowd : ndarray, shape (agents,)
+        Contacts at the last step, the sizes of the pushes of neighbours, walls and obstacles in
+        units of ``c_max``: what each agent broadcasts for the mean of pushes (C1).
+    pushed : ndarray, shape (agents, axes)
+        Work space: the pushes of the walls and obstacles this step.
+    limit : ndarray, shape (agents,)
+        Each agent's tilt limit this step: ``c_max``, or the walls' pushes together in a corner (W2).
+    c_max : float
+        The scenario's tilt limit (rad).
+    near_before : ndarray, shape (agents,)
+        Neighbours within reach at the step before (a rise is an encounter).
+    totals : ndarray, shape (agents, 6)
+        Each agent's running totals, in the order of :data:`tmem.engine.gas.TOTALS`.
+    """
+
+    observe: bool
+    mean: bool
+    rate: float
+    target2: np.ndarray
+    inv_g: float
+    g_dt: float
+    dt: float
+    walls: np.ndarray
+    obstacles: np.ndarray
+    wall_reach: float
+    near: np.ndarray
+    near_energy: np.ndarray
+    speed2: np.ndarray
+    energy: np.ndarray
+    stored: np.ndarray
+    energy_scale: float
+    virial: np.ndarray
+    wall_push: np.ndarray
+    wall_moment: np.ndarray
+    contact: np.ndarray
+    crowd: np.ndarray
+    pushed: np.ndarray
+    limit: np.ndarray
+    c_max: float
+    near_before: np.ndarray
+    totals: np.ndarray
 
 
 class Events(NamedTuple):

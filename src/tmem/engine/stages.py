@@ -29,7 +29,8 @@ from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale 
 from ..control import corrected_position, tilt_scale
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
-from .records import ADD, COUPLE, REMOVE, UNCOUPLE
+from .gas import clear, record_totals, tilt_limit
+from .records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
 CHUNK = 256
@@ -80,20 +81,21 @@ def commands_due(k, commands, counters):
 
 
 @numba.njit(cache=True)
-def apply_commands(k, commands, agents, pairs, events, counters):
+def apply_commands(k, commands, agents, pairs, events, counters, gas):
     """Carry out the commands due at step ``k``; return whether the neighbour lists must be rebuilt.
 
     Commands are rare: the loop calls this only when :func:`commands_due`, and it is not inlined.
     Inlined, its code slowed every step of a two-agent run by a quarter.
 
     ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.coupling`); ``remove`` stops an agent
-    where it is (a lost vehicle), ``add`` puts it back at its start.
+    where it is (a lost vehicle), ``add`` puts it back at its start; ``temperature`` sets the
+    thermostat's RMS velocity (:mod:`tmem.engine.gas`).
 
     Parameters
     ----------
     k : int
         The step.
-    commands, agents, pairs, events, counters
+    commands, agents, pairs, events, counters, gas
         The loop's records (:mod:`tmem.engine.records`); all but ``commands`` change in place.
     """
     rebuild = False
@@ -112,6 +114,9 @@ def apply_commands(k, commands, agents, pairs, events, counters):
             else:
                 agents.state[i, :, 1:] = 0.0
             log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind, -1)
+        elif kind == TEMPERATURE:
+            gas.target2[0] = commands.value[c] * commands.value[c]
+            log_event(events, counters, k, coupling.EVENT_COMMAND, -1, -1, kind, -1)
         else:
             every = first == commands.ptr[c + 1]
             for t in range(pairs.armed.shape[0] if every else commands.ptr[c + 1] - first):
@@ -128,8 +133,9 @@ def apply_commands(k, commands, agents, pairs, events, counters):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def corrected_positions(known, agents, law, run, neighbours):
-    """``P* = x . K / K_P`` (6) and ``P`` of every agent into ``agents.corrected``; clear the set-points.
+def corrected_positions(known, agents, law, run, neighbours, gas):
+    """``P* = x . K / K_P`` (6) and ``P`` of every agent into ``agents.corrected``; clear the set-points
+    (and, when the gas is observed, its counts: :func:`tmem.engine.gas.clear`).
 
     Returns the largest squared shift of a flying agent's ``P*`` since the lists were built (0
     without lists).
@@ -138,10 +144,11 @@ def corrected_positions(known, agents, law, run, neighbours):
     ----------
     known : ndarray, shape (agents, axes, n_state)
         The states as measured (:func:`tmem.sensing.measure`).
-    agents, law, run, neighbours
-        The loop's records (:mod:`tmem.engine.records`); ``agents`` changes in place.
+    agents, law, run, neighbours, gas
+        The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.
     """
     box = run.box
+    observe = gas.observe
     n_axes = len(box)
     use_lists = run.use_lists
     gains = law.gains
@@ -164,6 +171,8 @@ def corrected_positions(known, agents, law, run, neighbours):
                 if use_lists:
                     delta = nearest_image(corrected[i, a, 0] - p_ref[i, a], box[a])
                     shift2 += delta * delta
+            if observe:
+                clear(i, known, gas, n_axes)
             if active[i]:
                 block_shift2[b] = max(block_shift2[b], shift2)
     moved = 0.0
@@ -196,10 +205,11 @@ def _chunk_pushes(chunks, w, m, n_axes, function, params):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, w):
+def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, w, gas):
     """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
     the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
-    the work space.
+    the work space.  When the gas is observed, count each agent's neighbours within reach, the sum of
+    their ``|V|^2`` and the virial of the pushes (:class:`tmem.engine.records.Gas`).
 
     Called, not inlined: the loop calls it from two places, and each inlined copy of it (with the
     interaction functions inside) cost two seconds of the first run's compilation.  The call costs
@@ -217,6 +227,8 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, 
         _chunk_pushes(chunks, w, m, n_axes, function, params)
         for t in range(m):
             nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
+        if gas.observe:
+            _count(chunks, w, m, pairs, begin, n_axes, gas)
         for t in range(m):
             i = pairs[begin + t, 0]
             j = pairs[begin + t, 1]
@@ -227,7 +239,38 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, 
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def neighbour_pushes(agents, neighbours, law, params, run):
+def _count(chunks, w, m, pairs, begin, n_axes, gas):
+    """For the gas (:mod:`tmem.engine.gas`), on a chunk of pushes: each pair's push in units of
+    ``c_max`` added to both agents' contacts; under the mean of pushes (C1), the push divided by the
+    larger of its two agents' contacts at the step before; then each agent's neighbours within
+    reach, the sum of their energies, and each pair's ``(P_i - P_j) . u_ij`` added to both agents."""
+    for t in range(m):
+        if chunks[w, 2 * n_axes, t] < np.inf:
+            i = pairs[begin + t, 0]
+            j = pairs[begin + t, 1]
+            size2 = 0.0
+            for a in range(n_axes):
+                size2 += chunks[w, a, t] * chunks[w, a, t]
+            pressing = np.sqrt(size2) / gas.c_max
+            gas.contact[i] += pressing
+            gas.contact[j] += pressing
+            if gas.mean:
+                share = 1.0 / max(1.0, gas.crowd[i], gas.crowd[j])
+                for a in range(n_axes):
+                    chunks[w, a, t] *= share
+            virial = 0.0
+            for a in range(n_axes):
+                virial -= chunks[w, n_axes + a, t] * chunks[w, a, t]
+            gas.near[i] += 1.0
+            gas.near[j] += 1.0
+            gas.near_energy[i] += gas.energy[j]
+            gas.near_energy[j] += gas.energy[i]
+            gas.virial[i] += virial
+            gas.virial[j] += virial
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def neighbour_pushes(agents, neighbours, law, params, run, gas):
     """Sum the pushes of every listed non-formation pair within reach, ``f(|d|)`` along ``d / |d|``.
 
     (Parallel loops take plain arrays and numbers: the records' fields are read out before them.)
@@ -237,8 +280,9 @@ def neighbour_pushes(agents, neighbours, law, params, run):
 
     Parameters
     ----------
-    agents, neighbours, law, run
-        The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``neighbours`` change in place.
+    agents, neighbours, law, run, gas
+        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``neighbours`` and ``gas`` change
+        in place.
     params : FunctionParams
         The interaction functions' parameters.
     """
@@ -255,11 +299,11 @@ def neighbour_pushes(agents, neighbours, law, params, run):
         block_nearest2[b] = np.inf
         if block_ptr[b + 1] > block_ptr[b]:
             block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params,
-                                           setpoint, chunks, b)  # fmt: skip
+                                           setpoint, chunks, b, gas)  # fmt: skip
     nearest2 = np.inf
     if neighbours.n_pairs > neighbours.n_inside:
         nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint,
-                              chunks, n_blocks)  # fmt: skip
+                              chunks, n_blocks, gas)  # fmt: skip
     for b in range(n_blocks):
         nearest2 = min(nearest2, block_nearest2[b])
     neighbours.closest[0] = min(neighbours.closest[0], nearest2)
@@ -280,12 +324,12 @@ def is_recorded(k, run):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def record(agents, pairs, records, c_max, run, counters):
+def record(agents, pairs, records, c_max, run, counters, gas):
     """Record the step, before the vehicles move, with the saturated set-point applied over it.
 
     Parameters
     ----------
-    agents, pairs, records, run, counters
+    agents, pairs, records, run, counters, gas
         The loop's records (:mod:`tmem.engine.records`); ``records`` and ``counters`` change in place.
     c_max : float
         Tilt limit (rad).
@@ -298,7 +342,7 @@ def record(agents, pairs, records, c_max, run, counters):
             for m in range(agents.state.shape[2]):
                 records.state[q_record, q, a, m] = agents.state[i, a, m]
         records.active[q_record, q] = agents.active[i]
-        scale = tilt_scale(agents.setpoint, i, n_axes, c_max) if agents.active[i] else 0.0
+        scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas, i, c_max)) if agents.active[i] else 0.0
         for a in range(n_axes):
             records.control[q_record, q, a] = agents.setpoint[i, a] * scale
     for e in range(pairs.i.shape[0]):
@@ -312,4 +356,5 @@ def record(agents, pairs, records, c_max, run, counters):
             r2 += delta * delta
         records.distance[q_record, e] = np.sqrt(dist2)
         records.measure[q_record, e] = np.sqrt(r2)
+    record_totals(agents, gas, records, q_record, n_axes)
     counters.next_record[0] = q_record + 1

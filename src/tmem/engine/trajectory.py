@@ -71,6 +71,10 @@ class Trajectory:
     events : list of Event
     list_builds : int
         How often the neighbour lists were built.
+    gas : ndarray, shape (n_records, 7) or (n_records, 0)
+        When the gas is observed (:attr:`Scenario.gas_observed`), at each record the swarm's running
+        totals :data:`tmem.engine.gas.TOTALS` and then :data:`tmem.engine.gas.SNAPSHOT`
+        (:mod:`tmem.observables` reads them); no columns otherwise.
     """
 
     scenario: Scenario
@@ -91,6 +95,7 @@ class Trajectory:
     final_active: np.ndarray
     events: list[Event]
     list_builds: int
+    gas: np.ndarray
 
     @property
     def pairs(self) -> np.ndarray:

@@ -25,16 +25,19 @@ from .tables import (
     Agent,
     Command,
     ControllerParams,
+    CoverageParams,
     FieldError,
     FormationParams,
     InteractionParams,
     LinearModelParams,
     ModelParams,
     NeighborParams,
+    Obstacle,
     SimulationParams,
     SpaceParams,
     StrictModel,
     SwarmParams,
+    ThermostatParams,
     per_axis,
 )
 
@@ -93,6 +96,9 @@ class Scenario(StrictModel):
     neighbors: NeighborParams = NeighborParams()
     formation: FormationParams | None = None
     swarm: SwarmParams | None = None
+    thermostat: ThermostatParams | None = None
+    coverage: CoverageParams | None = None
+    obstacles: list[Obstacle] = []
     agents: list[Agent] = []
     commands: list[Command] = []
 
@@ -114,6 +120,25 @@ class Scenario(StrictModel):
         if self.formation is not None and self.formation.kind != "edges":
             return 3 if self.formation.kind == "triangle" else self.formation.n
         return len(self.agents)
+
+    @property
+    def wall_reach(self) -> float:
+        """``R + R_w``: walls and obstacles push an agent whose ``P*`` is closer than this (m)."""
+        radius = self.space.wall_radius
+        return self.interaction.radius + (self.interaction.radius if radius is None else radius)
+
+    @property
+    def gas_observed(self) -> bool:
+        """Whether the run keeps the gas's totals (:mod:`tmem.engine.gas`): asked for, or needed by the
+        mean of pushes, a thermostat, walls or obstacles."""
+        return (
+            self.simulation.observe_gas
+            or self.interaction.combine == "mean"
+            or self.thermostat is not None
+            or self.space.walls
+            or bool(self.obstacles)
+            or any(c.action == "temperature" for c in self.commands)
+        )
 
     def pairs(self) -> np.ndarray:
         """The pairs handled one by one, ``(i, j)`` with ``i < j``, shape ``(m, 2)``.
@@ -143,6 +168,7 @@ class Scenario(StrictModel):
         if n < 2:
             raise FieldError("agents", f"needs at least 2 agents, got {n}")
         self._check_space()
+        self._check_obstacles(axes)
         self._check_sampling()
         if self.formation is not None:
             self._check_formation(axes, n)
@@ -182,6 +208,43 @@ class Scenario(StrictModel):
                         f"{side:g} m is shorter than R + R_j = {reach:g} m: in a periodic box every agent "
                         "would meet its own images; make the box at least that wide",
                     )
+
+    def _check_obstacles(self, axes: int) -> None:
+        """Obstacles sized for the space; listed agents start inside the walls and off every obstacle."""
+        for k, obstacle in enumerate(self.obstacles):
+            if len(obstacle.center) != axes:
+                raise FieldError(f"obstacles[{k}].center", per_axis(axes, len(obstacle.center)))
+        box = self.space.box if self.space.walls else None
+        for k, agent in enumerate(self.agents):
+            place = np.ravel(agent.position) * np.ones(axes)
+            if box is not None and not np.all((place >= 0.0) & (place <= np.asarray(box))):
+                raise FieldError(f"agents[{k}].position", f"{place.tolist()} lies outside the walled box 0..{box}")
+            for o, obstacle in enumerate(self.obstacles):
+                if np.linalg.norm(place - np.asarray(obstacle.center)) < obstacle.radius:
+                    raise FieldError(f"agents[{k}].position", f"{place.tolist()} lies inside obstacles[{o}]")
+        if self.swarm is not None:
+            self._check_swarm_room(axes)
+        if self.coverage is not None and not self.space.walls:
+            raise FieldError("coverage", "measures a walled box: set space.walls = true and space.box")
+
+    def _check_swarm_room(self, axes: int) -> None:
+        """A swarm in a walled box starts clear of the walls' reach; the obstacles leave it room."""
+        inset = self.wall_reach if self.space.walls else 0.0
+        box = self.space.box
+        if self.space.walls:
+            for a, side in enumerate(self.swarm.region or np.asarray(box) - 2.0 * inset):
+                if not 0.0 < side <= box[a] - 2.0 * inset:
+                    field = "swarm.region" if self.swarm.region else "space.box"
+                    raise FieldError(f"{field}[{a}]", f"leaves no room for the swarm clear of the walls' reach "
+                                     f"R + R_w = {inset:g} m on each side of the {box[a]:g} m box")  # fmt: skip
+        region = self.swarm.region or (np.asarray(box) - 2.0 * inset if box is not None else None)
+        if region is not None and self.obstacles:
+            reach = self.wall_reach
+            ball = math.pi ** (axes / 2) / math.gamma(axes / 2 + 1)
+            covered = sum(ball * (o.radius + reach) ** axes for o in self.obstacles)
+            if covered > 0.5 * math.prod(region):
+                raise FieldError("obstacles", "with the walls' reach they cover more than half the swarm's region: "
+                                 "there is no room to place it")  # fmt: skip
 
     def _check_sampling(self) -> None:
         """The gains must not underflow, and dt must resolve the closed loop A - B K (roots (5))."""

@@ -2,7 +2,7 @@
 
 ``[model]`` (Table 1), ``[controller]`` (roots (5)), ``[interaction]`` (7)-(11),
 ``[simulation]``, ``[space]``, ``[neighbors]``, ``[formation]``, ``[swarm]``,
-``[[agents]]`` (Table 2) and ``[[commands]]``.  Each table checks its own keys;
+``[thermostat]``, ``[coverage]``, ``[[obstacles]]``, ``[[agents]]`` (Table 2) and ``[[commands]]``.  Each table checks its own keys;
 :mod:`tmem.scenario.schema` checks them against each other.  A check that
 spans fields raises :class:`FieldError` naming the field at fault.
 """
@@ -120,7 +120,10 @@ class InteractionParams(StrictModel):
     (``"energy"``, :mod:`tmem.coupling`).  ``synchronise``: a coupled pair
     damps its relative motion (its slow mode's damping ratio
     ``sync_damping``) and puts the energy into its common motion
-    (:mod:`tmem.synchronise`).
+    (:mod:`tmem.synchronise`).  ``combine``: an agent's pushes of several
+    neighbours are summed (``"sum"``, the paper's reading) or averaged over
+    the neighbours, walls and obstacles within reach (``"mean"``, which keeps
+    each agent's loop ``A - B K`` in crowds: :mod:`tmem.engine.gas`).
     """
 
     function: Literal[FUNCTION_NAMES] = "improved"
@@ -133,6 +136,7 @@ class InteractionParams(StrictModel):
     energy_tolerance: Annotated[float, Field(gt=0, lt=1)] = 0.05
     synchronise: bool = False
     sync_damping: Annotated[float, Field(gt=0, lt=1)] = 0.7
+    combine: Literal["sum", "mean"] = "sum"
 
     @property
     def reach(self) -> float:
@@ -155,6 +159,7 @@ class SimulationParams(StrictModel):
     duration: Positive = 60.0
     record_every: Annotated[int, Field(ge=1)] = 100
     record_agents: list[int] | None = None
+    observe_gas: bool = False
 
     @property
     def n_steps(self) -> int:
@@ -191,10 +196,14 @@ class SimulationParams(StrictModel):
 
 
 class SpaceParams(StrictModel):
-    """The space the agents fly in: 1 to 3 axes, optionally a periodic box."""
+    """The space the agents fly in: 1 to 3 axes, optionally a box from 0 to ``box`` on each axis,
+    periodic or walled.  ``wall_radius``: ``R_w``, a wall or obstacle pushes an agent whose ``P*`` is
+    within ``R + R_w`` of it (default ``R``)."""
 
     axes: Literal[1, 2, 3] = 1
     periodic: bool = False
+    walls: bool = False
+    wall_radius: Positive | None = None
     box: list[Positive] | None = None
 
     @model_validator(mode="after")
@@ -203,7 +212,36 @@ class SpaceParams(StrictModel):
             raise FieldError("box", per_axis(self.axes, len(self.box)))
         if self.periodic and self.box is None:
             raise FieldError("box", "is required when periodic = true")
+        if self.walls and self.box is None:
+            raise FieldError("box", "is required when walls = true")
+        if self.walls and self.periodic:
+            raise FieldError("walls", "a box is periodic or walled, not both")
         return self
+
+
+class Obstacle(StrictModel):
+    """A circle (a sphere in 3-D, an interval in 1-D) the agents keep off: a neighbour held still."""
+
+    center: Annotated[list[Number], Field(min_length=1, max_length=3)]
+    radius: Positive
+
+
+class CoverageParams(StrictModel):
+    """How the coverage of a walled box is measured (:mod:`tmem.coverage`): square cells of side
+    ``cell`` (m; default ``R``), each visited when an agent passes within ``sensor_radius`` (m) of its
+    centre (0: when it passes through the cell)."""
+
+    cell: Positive | None = None
+    sensor_radius: NonNegative = 0.0
+
+
+class ThermostatParams(StrictModel):
+    """The swarm's temperature as an operator's set-point: its RMS velocity ``rms_velocity`` (m/s;
+    none: the thermostat waits for a ``temperature`` command), reached with time constant ``tau`` (s)
+    (:mod:`tmem.engine.gas`)."""
+
+    rms_velocity: Positive | None = None
+    tau: Annotated[float, Field(gt=0, le=LIMIT)] = 5.0
 
 
 class NeighborParams(StrictModel):
@@ -274,18 +312,24 @@ class Command(StrictModel):
 
     ``couple`` / ``uncouple`` act on ``pair``, on the listed ``pairs``, or on
     every formation pair when neither is given; ``remove`` / ``add`` act on
-    ``agent``.
+    ``agent``; ``temperature`` sets the thermostat's RMS velocity to ``value`` (m/s).
     """
 
     time: NonNegative
-    action: Literal["couple", "uncouple", "remove", "add"]
+    action: Literal["couple", "uncouple", "remove", "add", "temperature"]
     pair: Pair | None = None
     pairs: list[Pair] | None = None
     agent: int | None = None
+    value: Positive | None = None
 
     @model_validator(mode="after")
     def _targets(self) -> "Command":
-        if self.action in ("couple", "uncouple"):
+        if (self.value is None) == (self.action == "temperature"):
+            raise FieldError("value", "is required for temperature" if self.value is None else f"is for temperature, not {self.action}")
+        if self.action == "temperature":
+            if self.agent is not None or self.pair is not None or self.pairs is not None:
+                raise FieldError("agent" if self.agent is not None else "pair", "a temperature command acts on the whole swarm")
+        elif self.action in ("couple", "uncouple"):
             if self.agent is not None:
                 raise FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
             if self.pair is not None and self.pairs is not None:

@@ -85,8 +85,16 @@ _PAIR_KEYS = (
     "|oscillation_amplitude|distance_error\\.(mean|rms|max)"
 )
 _FORMATION_KEYS = "formed_at|coupled_at_end|amplitude_max|direction_error_deg|distance_error\\.(mean|rms|max)"
-#: Nested figures of ``summary.json`` by dotted path: per formation, and per pair (by its index).
-NESTED_METRIC = re.compile(rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})")
+_GAS_KEYS = (
+    "rms_velocity|kinetic_energy_per_axis|density|pressure_virial|pressure_walls|pressure_wall_range"
+    "|pressure_ideal|encounter_rate|mean_free_path|breaches"
+)
+_COVERAGE_KEYS = "share_final|time_to_50|time_to_90"
+#: Nested figures of ``summary.json`` by dotted path: per formation, per pair (by its index), of the
+#: gas (:func:`tmem.observables.gas_summary`) and of the coverage (:func:`tmem.coverage.coverage_summary`).
+NESTED_METRIC = re.compile(
+    rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})|gas\.({_GAS_KEYS})|coverage\.({_COVERAGE_KEYS})"
+)
 #: Most cases one sweep may have.
 MAX_CASES = 1_000_000
 
@@ -201,7 +209,7 @@ class SweepFile(StrictModel):
             raise FieldError("cases", "counts random draws, but there is no [random] table")
         for m in self.metrics:
             if m not in SCALAR_METRICS and not NESTED_METRIC.fullmatch(m):
-                raise FieldError("metrics", f"unknown metric {m!r}; choose from {', '.join(SCALAR_METRICS)}, formation.*, pairs.N.*")
+                raise FieldError("metrics", f"unknown metric {m!r}; choose from {', '.join(SCALAR_METRICS)}, formation.*, pairs.N.*, gas.*, coverage.*")
         if len(set(self.metrics)) != len(self.metrics):
             raise FieldError("metrics", "lists a metric twice")
         where: dict[str, str] = {}  # path -> the table that gives it; explicit cases may share paths
