@@ -219,8 +219,8 @@ def unsupported(scenario: Scenario) -> str | None:
 
     A batch needs encounters of two agents: two agents listed, flying from
     level starts (tilts and tilt rates zero), without a formation, in open
-    space on any number of axes, with at most one command (an uncouple), on
-    the linear model.  Only the agents' positions and velocities vary.
+    space on any number of axes (no walls, obstacles or gas options), with at
+    most one command (an uncouple), on the linear model.  Only the agents' positions and velocities vary.
 
     Parameters
     ----------
@@ -231,8 +231,10 @@ def unsupported(scenario: Scenario) -> str | None:
         return "needs the linear model (2), whose exact step the batch takes"
     if len(scenario.agents) != 2 or scenario.formation is not None:
         return "needs two agents listed in [[agents]], without a formation"
-    if scenario.space.periodic:
-        return "needs open space: free flight is skipped in closed form, without a box to wrap in"
+    if scenario.space.periodic or scenario.space.walls or scenario.obstacles:
+        return "needs open space: free flight is skipped in closed form, without walls, obstacles or a box to wrap in"
+    if scenario.gas_observed:
+        return "the gas's options (thermostat, mean of pushes, observed totals) are the step loop's"
     if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
         return "at most one command, an uncouple"
     if any(not np.all(np.equal(a.tilt, 0)) or not np.all(np.equal(a.tilt_rate, 0)) or not a.active for a in scenario.agents):

@@ -75,7 +75,8 @@ class Coverage:
     box: tuple[float, ...]
 
     def time_to(self, share: float) -> float | None:
-        """The first record time at which the covered share reaches ``share``.
+        """The time at which the covered share first reaches ``share``: the first visit of the cell
+        that brings it there (interpolated between records, as ``first_visit`` is).
 
         Parameters
         ----------
@@ -89,8 +90,9 @@ class Coverage:
         """
         if not math.isfinite(share):
             raise ValueError(f"share: must be a finite number, got {share!r}")
-        reached = np.flatnonzero(self.share >= share - _SHARE_TOL)
-        return float(self.time[reached[0]]) if reached.size else None
+        visits = np.sort(self.first_visit[self.field & np.isfinite(self.first_visit)])
+        needed = max(1, math.ceil((share - _SHARE_TOL) * int(self.field.sum())))
+        return float(visits[needed - 1]) if needed <= visits.size else None
 
 
 def coverage(
@@ -394,7 +396,8 @@ def plot_coverage(cov: Coverage, ax=None, obstacles: Sequence[Obstacle] = (), ti
 def run_coverage(trajectory) -> Coverage | None:
     """The coverage of a run's walled box (:func:`coverage` on its recorded agents), with the cell
     and sensor radius of its ``[coverage]`` table (default: cells of side ``R``, sensor radius 0);
-    ``None`` when the run has no walled box or recorded nothing.
+    ``None`` when the run has no walled box, recorded nothing, or its box would need more than
+    :data:`MAX_CELLS` cells of side ``R``.
 
     Parameters
     ----------
@@ -405,7 +408,9 @@ def run_coverage(trajectory) -> Coverage | None:
     if not scenario.space.walls or not len(trajectory.time) or not trajectory.state.shape[1]:
         return None
     settings = scenario.coverage
-    cell = scenario.interaction.radius if settings is None or settings.cell is None else settings.cell
+    cell = scenario.coverage_cell
+    if math.prod(math.ceil(side / cell) for side in scenario.space.box[:2]) > MAX_CELLS:
+        return None  # a field too fine to map by default (a [coverage] table this fine is refused)
     radius = 0.0 if settings is None else settings.sensor_radius
     obstacles = [(o.center[:2], o.radius) for o in scenario.obstacles]
     return coverage(trajectory.state[..., 0], trajectory.time, trajectory.active, scenario.space.box, cell,

@@ -11,8 +11,10 @@ mass: a tilt ``phi`` is an acceleration ``g phi``.
   obstacles in it.
 * **Pressure from the virial** (G1): ``p V D = <sum_i |V_i|^2> + <sum_pairs r_ij . a_ij>`` with
   ``r_ij = P_i - P_j`` and ``a_ij`` the push of ``j`` on ``i`` as applied (after the tilt limit),
-  averaged over the window; in a walled box less the boundary term ``[sum_i r_i . V_i] / T`` of the
-  window (``r_i`` from the box's centre), which the theorem's average over a finite ``T`` keeps.
+  averaged over the window.  In a periodic box ``sum_pairs`` runs over the pairs and ``V`` is the
+  free volume.  In a walled box it is each agent's ``(P_i - c) . a_i`` over every push but the
+  walls' (the obstacles' included), ``c`` the box's centre, ``V`` the whole box, less the boundary
+  term ``[sum_i (P_i - c) . V_i] / T`` that the theorem's average over a finite window ``T`` keeps.
 * **Pressure on the walls** (G2): the momentum the walls of the box receive per unit time and unit
   area (length in 2-D), from the walls' pushes as applied.  Over a bounce the tilt's integral equals
   the set-point's (the inner loop has a static gain of one), so the momentum is exact.
@@ -121,9 +123,11 @@ def gas_summary(trajectory: Trajectory, since: float | None = None) -> dict | No
     volume, area = free_volume(trajectory), wall_area(trajectory)
     encounters = delta[_COLUMN["encounters"]]
     boundary = delta[_COLUMN["moment"]] / span
-    virial = (speed2 + delta[_COLUMN["virial"]] / span - boundary) / (axes * volume) if volume else None
+    # A walled box's virial holds the obstacles' pushes, so it acts on the whole box (G1).
+    container = math.prod(trajectory.scenario.space.box) if area else volume
+    virial = (speed2 + delta[_COLUMN["virial"]] / span - boundary) / (axes * container) if volume else None
     walls = delta[_COLUMN["wall_momentum"]] / (span * area) if area else None
-    wall_range = delta[_COLUMN["wall_virial"]] / (span * axes * volume) if area else None
+    wall_range = delta[_COLUMN["wall_virial"]] / (span * axes * container) if area else None
     return {
         "window": [float(time[start]), float(time[-1])],
         "rms_velocity": math.sqrt(speed2 / flying) if flying > 0 else None,

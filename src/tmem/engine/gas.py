@@ -9,10 +9,10 @@ The derivations are in ``docs/gas.md``; equation labels below refer to it.
   agents' contacts, as each broadcast them at the step before: pushes stay equal and opposite, and
   no agent's gains add up to much more than one ``K``.  The modes of a crowd are then
   ``A - lambda B K`` with ``lambda`` in ``[0, 2]``, on which the slow pair stays within
-  ``6e-6 / s`` of the imaginary axis.  A contact counts by the size of its push over ``c_max``
-  (from 0 at the edge of reach to 1 at saturation), so that a neighbour coming within reach changes
-  the weights smoothly: counted whole at once, each arrival would jolt the others' pushes and heat
-  the gas.  With one neighbour nothing changes.
+  ``6e-6 / s`` of the imaginary axis.  A contact counts by the square of its push's size over
+  ``c_max`` (from 0 at the edge of reach to 1 at saturation), so that a neighbour coming within
+  reach changes the weights smoothly: counted whole at once, each arrival would jolt the others'
+  pushes.  With one neighbour nothing changes.
 * **Thermostat (T1)-(T2).**  Each agent estimates the temperature from what it knows: its own
   energy and its neighbours' within reach, each ``|V|^2`` plus the energy its pushes hold,
   ``(g |U| / omega)^2`` with ``omega`` its slow mode's frequency (T2).  It tilts along its velocity
@@ -43,6 +43,14 @@ from .records import Gas
 #: the rises of the agent's count of them, step to step), path flown (m), and steps spent beyond a
 #: wall or inside an obstacle.
 TOTALS = ("wall_momentum", "wall_virial", "virial", "encounters", "path", "breaches")
+WALL_MOMENTUM, WALL_VIRIAL, VIRIAL_TOTAL, ENCOUNTERS, PATH, BREACHES = range(len(TOTALS))
+#: Columns of ``Gas.work``, one row per agent, cleared at each step: neighbours within reach, their
+#: pushes' sizes over ``c_max``, their energies, the agent's virial (rad m), its ``|V|^2``, its
+#: energy, the size of the box walls' pushes (rad) and their moment about the walls (rad m).
+NEAR, CONTACT, NEAR_ENERGY, VIRIAL, SPEED2, ENERGY, WALL_PUSH, WALL_MOMENT = range(8)
+#: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
+#: step before, contacts at the step before (C1), the energy its pushes held (T2), its tilt limit.
+NEAR_BEFORE, CROWD, STORED, LIMIT = range(4)
 #: Long name and units of each column of a record (:data:`TOTALS` then :data:`SNAPSHOT`), running
 #: totals over every agent since the start, per unit agent mass.
 COLUMNS = {
@@ -63,8 +71,10 @@ SNAPSHOT = ("speed2_sum", "flying", "moment")
 
 
 @numba.njit(cache=True, inline="always")
-def clear(i, known, gas, n_axes):
-    """Start agent ``i``'s step: nothing counted yet; its own ``|V|^2`` as known.
+def clear(i, known, work, kept, c_max, n_axes):
+    """Start agent ``i``'s step: nothing counted yet; its own ``|V|^2`` and energy as known.
+
+    Called in a parallel loop: it takes the record's arrays, not the record.
 
     Parameters
     ----------
@@ -72,23 +82,61 @@ def clear(i, known, gas, n_axes):
         The agent's slot.
     known : ndarray, shape (agents, axes, n_state)
         The states as measured.
-    gas : Gas
-        The record (:class:`tmem.engine.records.Gas`), changed in place.
+    work, kept : ndarray
+        ``Gas.work`` and ``Gas.kept`` (:class:`tmem.engine.records.Gas`), changed in place.
+    c_max : float
+        The scenario's tilt limit (rad).
     n_axes : int
         Number of axes.
     """
     speed2 = 0.0
     for a in range(n_axes):
         speed2 += known[i, a, 1] * known[i, a, 1]
-    gas.speed2[i] = speed2
-    gas.energy[i] = speed2 + gas.stored[i]
-    gas.near[i] = 0.0
-    gas.contact[i] = 0.0
-    gas.near_energy[i] = 0.0
-    gas.virial[i] = 0.0
-    gas.wall_push[i] = 0.0
-    gas.wall_moment[i] = 0.0
-    gas.limit[i] = gas.c_max
+    for c in range(work.shape[1]):
+        work[i, c] = 0.0
+    work[i, SPEED2] = speed2
+    work[i, ENERGY] = speed2 + kept[i, STORED]
+    kept[i, LIMIT] = c_max
+
+
+@numba.njit(cache=True, inline="always")
+def pair_share(i, j, kept):
+    """The factor (C1) divides the push of the pair ``(i, j)`` by: the larger of its agents' contacts.
+
+    Parameters
+    ----------
+    i, j : int
+        The agents' slots.
+    kept : ndarray
+        ``Gas.kept``.
+    """
+    return 1.0 / max(1.0, kept[i, CROWD], kept[j, CROWD])
+
+
+@numba.njit(cache=True, inline="always")
+def add_contact(i, j, pressing, virial, work):
+    """Count the pair ``(i, j)`` within reach for both agents: its push's squared size over ``c_max^2``, each
+    other's energy, and the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
+
+    Parameters
+    ----------
+    i, j : int
+        The agents' slots.
+    pressing : float
+        The pair's push's squared size over ``c_max^2``.
+    virial : float
+        ``(P_i - P_j) . u_ij``, the push on ``i`` as applied.
+    work : ndarray
+        ``Gas.work``, changed in place.
+    """
+    work[i, NEAR] += 1.0
+    work[j, NEAR] += 1.0
+    work[i, CONTACT] += pressing
+    work[j, CONTACT] += pressing
+    work[i, NEAR_ENERGY] += work[j, ENERGY]
+    work[j, NEAR_ENERGY] += work[i, ENERGY]
+    work[i, VIRIAL] += virial
+    work[j, VIRIAL] += virial
 
 
 @numba.njit(cache=True, inline="always")
@@ -105,13 +153,14 @@ def _obstacle_gap(i, o, corrected, obstacles, box, n_axes):
 @numba.njit(cache=True, inline="always")
 def _wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes):
     """The pushes (8) of the walls and obstacles within reach of agent ``i``'s ``P*`` (W1), summed into
-    ``pushed[i]``; return how many pushed, the sum of their sizes in units of ``c_max`` (C1), the
-    size of the box walls' pushes (rad), and their sum weighted by the agent's distance ``P`` from
-    each wall (rad m)."""
+    ``pushed[i]``.  Return how many pushed; the sum of their squared sizes over ``c_max^2`` (C1); the
+    size of the box walls' pushes (rad) and their sum weighted by the agent's distance ``P`` from
+    each wall (rad m); and the obstacles' virial ``(P - c) . u`` about the box's centre ``c``."""
     contacts = 0
     pressing = 0.0
     on_walls = 0.0
     moment = 0.0
+    obstacle_virial = 0.0
     reach = wall_params.reach
     for a in range(n_axes):
         pushed[i, a] = 0.0
@@ -124,33 +173,37 @@ def _wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axe
                 on_walls -= u
                 moment -= u * corrected[i, a, 1]
                 contacts += 1
-                pressing -= u / wall_params.c_max
+                pressing += (u / wall_params.c_max) ** 2
             if high < reach:
                 u = repulsion(max(high, 0.0), 0, wall_params)
                 pushed[i, a] += u
                 on_walls -= u
                 moment -= u * (walls[a] - corrected[i, a, 1])
                 contacts += 1
-                pressing -= u / wall_params.c_max
+                pressing += (u / wall_params.c_max) ** 2
     for o in range(obstacles.shape[0]):
         centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
         if gap < reach and centre > 0.0:
             u = repulsion(max(gap, 0.0), 0, wall_params)
             for a in range(n_axes):
-                pushed[i, a] += u * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
+                along = u * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
+                pushed[i, a] += along
+                obstacle_virial += (corrected[i, a, 1] - 0.5 * walls[a]) * along
             contacts += 1
-            pressing -= u / wall_params.c_max
-    return contacts, pressing, on_walls, moment
+            pressing += (u / wall_params.c_max) ** 2
+    return contacts, pressing, on_walls, moment, obstacle_virial
 
 
 @numba.njit(cache=True, inline="always")
 def _keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes):
     """Drop from agent ``i``'s other pushes the part that points into a wall or an obstacle within
     reach of its ``P*`` (W2): neighbours, formation pulls and the thermostat never push it through.
-    The wall takes what is dropped: return its size on the box's walls (rad), and its sum weighted
-    by the agent's distance ``P`` from each wall (rad m), as :func:`_wall_pushes` does."""
+    The wall or obstacle takes what is dropped: return its size on the box's walls (rad), its sum
+    weighted by the agent's distance ``P`` from each wall (rad m), as :func:`_wall_pushes` does, and
+    the virial ``(P - c) . u`` of what the obstacles took."""
     held = 0.0
     moment = 0.0
+    obstacle_virial = 0.0
     for a in range(n_axes):
         if walls[a] > 0.0:
             if corrected[i, a, 0] < reach and setpoint[i, a] < 0.0:
@@ -169,8 +222,10 @@ def _keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes):
                 inward += setpoint[i, a] * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
             if inward > 0.0:
                 for a in range(n_axes):
-                    setpoint[i, a] -= inward * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
-    return held, moment
+                    dropped = inward * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
+                    setpoint[i, a] -= dropped
+                    obstacle_virial -= (corrected[i, a, 1] - 0.5 * walls[a]) * dropped
+    return held, moment, obstacle_virial
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -208,8 +263,23 @@ def _stiffness(near, crowd, mean):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
+def _thermostat(i, known, setpoint, pushed, work, kept, contacts, mean, rate, target2, inv_g, energy_scale, n_axes):
+    """Add agent ``i``'s thermostat push (T1) along its velocity, from its estimate of the
+    temperature (T2): the mean energy of itself and its neighbours within reach."""
+    pushed2 = 0.0
+    for a in range(n_axes):
+        total = setpoint[i, a] + (pushed[i, a] if contacts > 0 else 0.0)
+        pushed2 += total * total
+    kept[i, STORED] = energy_scale * pushed2 / _stiffness(work[i, NEAR], kept[i, CROWD], mean)
+    temperature = (work[i, SPEED2] + kept[i, STORED] + work[i, NEAR_ENERGY]) / (1.0 + work[i, NEAR])
+    push = rate * (target2 / temperature - 1.0) * inv_g if temperature > 0.0 else 0.0
+    for a in range(n_axes):
+        setpoint[i, a] += push * known[i, a, 1]
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def gas_pushes(known, agents, gas, wall_params, run):
-    """Walls and obstacles (W1)-(W2) and the thermostat (T1)-(T2), agent by agent, after the
+    """The thermostat (T1)-(T2), then walls and obstacles (W1)-(W2), agent by agent, after the
     neighbour pushes and the formation pairs; count the neighbours that came within reach.
 
     (Parallel loops take plain arrays and numbers: the records' fields are read out before them.)
@@ -230,86 +300,75 @@ def gas_pushes(known, agents, gas, wall_params, run):
     active = agents.active
     walls = gas.walls
     obstacles = gas.obstacles
-    near = gas.near
-    near_before = gas.near_before
-    crowd = gas.crowd
-    contact = gas.contact
+    work = gas.work
+    kept = gas.kept
+    pushed = gas.pushed
+    totals = gas.totals
     bounded = obstacles.shape[0] > 0
     for a in range(n_axes):
         bounded = bounded or walls[a] > 0.0
-    pushed = gas.pushed
-    limit = gas.limit
-    virial = gas.virial
     walled = walls[0] > 0.0
-    wall_push = gas.wall_push
-    wall_moment = gas.wall_moment
-    totals = gas.totals
     mean = gas.mean
     rate = gas.rate
     target2 = gas.target2[0]
     inv_g = gas.inv_g
-    speed2 = gas.speed2
-    stored = gas.stored
     energy_scale = gas.energy_scale
-    near_energy = gas.near_energy
     reach = wall_params.reach
     c_max = wall_params.c_max
+    first = gas.first[0]
+    gas.first[0] = False
     for i in numba.prange(known.shape[0]):
         if not active[i]:
             continue
         contacts = 0
         pressing = 0.0
+        obstacles_virial = 0.0
         if bounded:
-            contacts, pressing, wall_push[i], wall_moment[i] = _wall_pushes(i, corrected, pushed, walls, obstacles,
-                                                                            box, wall_params, n_axes)  # fmt: skip
-        crowd[i] = contact[i] + pressing
-        totals[i, 3] += max(near[i] - near_before[i], 0.0)
-        near_before[i] = near[i]
+            contacts, pressing, work[i, WALL_PUSH], work[i, WALL_MOMENT], obstacles_virial = _wall_pushes(
+                i, corrected, pushed, walls, obstacles, box, wall_params, n_axes)  # fmt: skip
+        kept[i, CROWD] = work[i, CONTACT] + pressing
+        if not first:  # the neighbours present at the start are not encounters
+            totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
+        kept[i, NEAR_BEFORE] = work[i, NEAR]
         if rate > 0.0 and target2 > 0.0:
-            pushed2 = 0.0
-            for a in range(n_axes):
-                total = setpoint[i, a] + (pushed[i, a] if contacts > 0 else 0.0)
-                pushed2 += total * total
-            stored[i] = energy_scale * pushed2 / _stiffness(near[i], crowd[i], mean)
-            temperature = (speed2[i] + stored[i] + near_energy[i]) / (1.0 + near[i])
-            push = rate * (target2 / temperature - 1.0) * inv_g if temperature > 0.0 else 0.0
-            for a in range(n_axes):
-                setpoint[i, a] += push * known[i, a, 1]
+            _thermostat(i, known, setpoint, pushed, work, kept, contacts, mean, rate, target2, inv_g, energy_scale, n_axes)
         if walled:  # the virial of every push but the walls', about the box's centre (G1)
             own = 0.0
             for a in range(n_axes):
                 own += (corrected[i, a, 1] - 0.5 * walls[a]) * setpoint[i, a]
-            virial[i] = own
+            work[i, VIRIAL] = own
         else:  # each pair's half
-            virial[i] *= 0.5
+            work[i, VIRIAL] *= 0.5
         if contacts > 0:  # what the walls drop of the others becomes the walls' own push (W2)
-            held, held_moment = _keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes)
-            others, limit[i] = _with_priority(i, setpoint, pushed, c_max, n_axes)
-            wall_push[i] += others * held
-            wall_moment[i] += others * held_moment
-            virial[i] *= others
+            held, held_moment, dropped_virial = _keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes)
+            others, kept[i, LIMIT] = _with_priority(i, setpoint, pushed, c_max, n_axes)
+            work[i, WALL_PUSH] += others * held
+            work[i, WALL_MOMENT] += others * held_moment
+            work[i, VIRIAL] = others * (work[i, VIRIAL] + dropped_virial) + obstacles_virial
 
 
 @numba.njit(cache=True, inline="always")
-def tilt_limit(gas, i, c_max):
+def tilt_limit(observe, kept, i, c_max):
     """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`_with_priority`).
 
     Parameters
     ----------
-    gas : Gas
-        The record.
+    observe : bool
+        Whether the gas is observed (``Gas.observe``; else ``kept`` is empty).
+    kept : ndarray
+        ``Gas.kept``.
     i : int
         The agent's slot.
     c_max : float
         The scenario's tilt limit (rad).
     """
-    return gas.limit[i] if gas.observe else c_max
+    return kept[i, LIMIT] if observe else c_max
 
 
 @numba.njit(cache=True, inline="always")
-def tally(x, i, scale, gas, n_axes):
-    """Add agent ``i``'s step to its totals, after its vehicle's step; ``scale`` is the factor that
-    saturated its set-point.
+def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes):
+    """Add agent ``i``'s step to its totals, after its vehicle's step.  Called in a parallel loop: it
+    takes the record's arrays and numbers, not the record.
 
     Parameters
     ----------
@@ -319,28 +378,33 @@ def tally(x, i, scale, gas, n_axes):
         The agent's slot.
     scale : float
         The saturation factor of its set-point this step (:func:`tmem.control.tilt_scale`).
-    gas : Gas
-        The record, changed in place.
+    work, totals, walls, obstacles : ndarray
+        ``Gas.work``, ``Gas.totals`` (changed in place), ``Gas.walls``, ``Gas.obstacles``.
+    box : tuple of float
+        The periodic box's sides (0: open axis).
+    g_dt, dt : float
+        ``g dt`` and ``dt``.
     n_axes : int
         Number of axes.
     """
-    applied = scale * gas.g_dt
-    gas.totals[i, 0] += applied * gas.wall_push[i]
-    gas.totals[i, 1] += applied * gas.wall_moment[i]
-    gas.totals[i, 2] += applied * gas.virial[i]
-    gas.totals[i, 4] += np.sqrt(gas.speed2[i]) * gas.dt
+    applied = scale * g_dt
+    totals[i, WALL_MOMENTUM] += applied * work[i, WALL_PUSH]
+    totals[i, WALL_VIRIAL] += applied * work[i, WALL_MOMENT]
+    totals[i, VIRIAL_TOTAL] += applied * work[i, VIRIAL]
+    totals[i, PATH] += np.sqrt(work[i, SPEED2]) * dt
     outside = False
     for a in range(n_axes):
-        if gas.walls[a] > 0.0 and not 0.0 <= x[i, a, 0] <= gas.walls[a]:
+        if walls[a] > 0.0 and not 0.0 <= x[i, a, 0] <= walls[a]:
             outside = True
-    for o in range(gas.obstacles.shape[0]):
+    for o in range(obstacles.shape[0]):
         r2 = 0.0
         for a in range(n_axes):
-            r2 += (x[i, a, 0] - gas.obstacles[o, a]) ** 2
-        if r2 < gas.obstacles[o, n_axes] ** 2:
+            delta = nearest_image(x[i, a, 0] - obstacles[o, a], box[a])
+            r2 += delta * delta
+        if r2 < obstacles[o, n_axes] ** 2:
             outside = True
     if outside:
-        gas.totals[i, 5] += 1.0
+        totals[i, BREACHES] += 1.0
 
 
 @numba.njit(cache=True, inline="always")
@@ -416,20 +480,11 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         walls=walls,
         obstacles=obstacles,
         wall_reach=scenario.wall_reach,
-        near=np.zeros(size),
-        near_energy=np.zeros(size),
-        speed2=np.zeros(size),
-        energy=np.zeros(size),
-        stored=np.zeros(size),
         energy_scale=(acceleration_per_tilt / scenario.controller.im_r) ** 2,
-        virial=np.zeros(size),
-        wall_push=np.zeros(size),
-        wall_moment=np.zeros(size),
-        crowd=np.zeros(size),
-        contact=np.zeros(size),
-        pushed=np.zeros((size, space.axes)),
-        limit=np.full(size, scenario.interaction.c_max),
         c_max=scenario.interaction.c_max,
-        near_before=np.zeros(size),
+        first=np.ones(1, dtype=np.bool_),
+        work=np.zeros((size, 8)),
+        kept=np.zeros((size, 4)),
+        pushed=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),
     )

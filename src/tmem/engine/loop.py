@@ -62,6 +62,9 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     x = agents.state
     u = agents.setpoint
     active = agents.active
+    observe = gas.observe
+    work, kept, totals = gas.work, gas.kept, gas.totals  # parallel loops take arrays, not records
+    walls, obstacles, g_dt, dt = gas.walls, gas.obstacles, gas.g_dt, gas.dt
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
         rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters, gas)
@@ -81,13 +84,13 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
         if k < run.n_steps:
             for i in numba.prange(x.shape[0]):
                 if active[i]:
-                    scale = tilt_scale(u, i, n_axes, tilt_limit(gas, i, c_max))
+                    scale = tilt_scale(u, i, n_axes, tilt_limit(observe, kept, i, c_max))
                     vehicle_step(x, u, i, scale, vehicle, n_axes)
                     for a in range(n_axes):
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
                             x[i, a, 0] = into_box(x[i, a, 0], box[a])
-                    if gas.observe:
-                        tally(x, i, scale, gas, n_axes)
+                    if observe:
+                        tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes)
     counters.step[0] = k_stop
     return DONE
 

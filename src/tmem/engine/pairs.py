@@ -15,6 +15,7 @@ from .. import coupling
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
 from ..synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
+from .gas import add_contact, pair_share
 from .stages import log_event
 
 
@@ -174,9 +175,9 @@ def _count_pair(e, agents, pairs, law, params, box, gas):
     size2 = 0.0
     for a in range(n_axes):
         size2 += d[a] * d[a]
-    pressing = np.sqrt(size2) / params.c_max
+    pressing = size2 / (params.c_max * params.c_max)
     if gas.mean and not law.couples:
-        share = 1.0 / max(1.0, gas.crowd[i], gas.crowd[j])
+        share = pair_share(i, j, gas.kept)
         if share < 1.0:
             for a in range(n_axes):
                 agents.setpoint[i, a] -= (1.0 - share) * d[a]
@@ -185,14 +186,7 @@ def _count_pair(e, agents, pairs, law, params, box, gas):
     virial = 0.0
     for a in range(n_axes):
         virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
-    gas.contact[i] += pressing
-    gas.contact[j] += pressing
-    gas.near[i] += 1.0
-    gas.near[j] += 1.0
-    gas.near_energy[i] += gas.energy[j]
-    gas.near_energy[j] += gas.energy[i]
-    gas.virial[i] += virial
-    gas.virial[j] += virial
+    add_contact(i, j, pressing, virial, gas.work)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")

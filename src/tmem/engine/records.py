@@ -235,9 +235,9 @@ class Gas(NamedTuple):
     observe : bool
         Count neighbours and keep the totals: on when any option below is, or when asked.
     mean : bool
-        ``interaction.combine == "mean"``: pushes divided by the number of contacts (C1).
+        ``interaction.combine == "mean"``: pushes divided by the pair's contacts (C1).
     rate : float
-        ``1 / (2 tau)`` of the thermostat (T1) (1/s); 0: no thermostat.
+        ``1 / (2 tau)`` of the thermostat (T1) (1/s).
     target2 : ndarray, shape (1,)
         The set mean square speed (m^2/s^2); 0: the thermostat waits for a command.
     inv_g : float
@@ -252,25 +252,21 @@ class Gas(NamedTuple):
         Centre and radius of each circle (sphere in 3-D).
     wall_reach : float
         ``R + R_w`` (m): a wall or obstacle pushes an agent whose ``P*`` is closer to it than that.
-    near, near_energy, speed2, virial, wall_push, wall_moment : ndarray, shape (agents,) (empty when not observed)
-        Work space of a step: neighbours within reach, the sum of their energies, the agent's own
-        ``|V|^2``, its virial (rad m: in a walled box ``(P_i - c) . u_i`` over every push but the
-        walls', ``c`` the box's centre; else half of ``sum_j (P_i - P_j) . u_ij`` over its
-        neighbours), the size of the box walls' pushes (rad) and their sum weighted by the agent's
-        distance from each wall (rad m).
-    contact : ndarray, shape (agents,)
-        Work space: the sizes of this step's pushes of neighbours in units of ``c_max``.
-    crowd : ndarray, shape (agents,)
-        Contacts at the last step, the sizes of the pushes of neighbours, walls and obstacles in
-        units of ``c_max``: what each agent broadcasts for the mean of pushes (C1).
-    pushed : ndarray, shape (agents, axes)
-        Work space: the pushes of the walls and obstacles this step.
-    limit : ndarray, shape (agents,)
-        Each agent's tilt limit this step: ``c_max``, or the walls' pushes together in a corner (W2).
+    energy_scale : float
+        ``(g / im_r)^2``: the energy a push holds per rad^2 at the slow mode of ``A - B K`` (T2).
     c_max : float
         The scenario's tilt limit (rad).
-    near_before : ndarray, shape (agents,)
-        Neighbours within reach at the step before (a rise is an encounter).
+    first : ndarray, shape (1,), bool
+        True until the first step's neighbours are counted: they are not encounters.
+    work : ndarray, shape (agents, 8) (no rows when not observed)
+        Each agent's work space of a step, in the columns :data:`tmem.engine.gas.NEAR` ...
+        :data:`tmem.engine.gas.WALL_MOMENT`: one row per agent, so that a pair's counts touch two
+        rows.
+    kept : ndarray, shape (agents, 4)
+        What each agent keeps from step to step (:data:`tmem.engine.gas.NEAR_BEFORE` ...
+        :data:`tmem.engine.gas.LIMIT`), among them its contacts, which it broadcasts (C1).
+    pushed : ndarray, shape (agents, axes)
+        Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)
         Each agent's running totals, in the order of :data:`tmem.engine.gas.TOTALS`.
     """
@@ -285,21 +281,12 @@ class Gas(NamedTuple):
     walls: np.ndarray
     obstacles: np.ndarray
     wall_reach: float
-    near: np.ndarray
-    near_energy: np.ndarray
-    speed2: np.ndarray
-    energy: np.ndarray
-    stored: np.ndarray
     energy_scale: float
-    virial: np.ndarray
-    wall_push: np.ndarray
-    wall_moment: np.ndarray
-    contact: np.ndarray
-    crowd: np.ndarray
-    pushed: np.ndarray
-    limit: np.ndarray
     c_max: float
-    near_before: np.ndarray
+    first: np.ndarray
+    work: np.ndarray
+    kept: np.ndarray
+    pushed: np.ndarray
     totals: np.ndarray
 
 

@@ -29,7 +29,7 @@ from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale 
 from ..control import corrected_position, tilt_scale
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
-from .gas import clear, record_totals, tilt_limit
+from .gas import add_contact, clear, pair_share, record_totals, tilt_limit
 from .records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
@@ -149,6 +149,9 @@ def corrected_positions(known, agents, law, run, neighbours, gas):
     """
     box = run.box
     observe = gas.observe
+    work = gas.work
+    kept = gas.kept
+    c_max = gas.c_max
     n_axes = len(box)
     use_lists = run.use_lists
     gains = law.gains
@@ -172,7 +175,7 @@ def corrected_positions(known, agents, law, run, neighbours, gas):
                     delta = nearest_image(corrected[i, a, 0] - p_ref[i, a], box[a])
                     shift2 += delta * delta
             if observe:
-                clear(i, known, gas, n_axes)
+                clear(i, known, work, kept, c_max, n_axes)
             if active[i]:
                 block_shift2[b] = max(block_shift2[b], shift2)
     moved = 0.0
@@ -228,7 +231,8 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, 
         for t in range(m):
             nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
         if gas.observe:
-            _count(chunks, w, m, pairs, begin, n_axes, gas)
+            _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas)
+            continue
         for t in range(m):
             i = pairs[begin + t, 0]
             j = pairs[begin + t, 1]
@@ -239,11 +243,15 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, 
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _count(chunks, w, m, pairs, begin, n_axes, gas):
-    """For the gas (:mod:`tmem.engine.gas`), on a chunk of pushes: each pair's push in units of
-    ``c_max`` added to both agents' contacts; under the mean of pushes (C1), the push divided by the
-    larger of its two agents' contacts at the step before; then each agent's neighbours within
-    reach, the sum of their energies, and each pair's ``(P_i - P_j) . u_ij`` added to both agents."""
+def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
+    """Add a chunk's pushes to ``u`` as :func:`_pushes_of` does, for the gas (:mod:`tmem.engine.gas`):
+    under the mean of pushes (C1) each push divided by :func:`tmem.engine.gas.pair_share`, and each
+    pair within reach counted for both its agents (:func:`tmem.engine.gas.add_contact`), in one
+    pass."""
+    work = gas.work
+    kept = gas.kept
+    mean = gas.mean
+    inv_c_max2 = 1.0 / (gas.c_max * gas.c_max)
     for t in range(m):
         if chunks[w, 2 * n_axes, t] < np.inf:
             i = pairs[begin + t, 0]
@@ -251,22 +259,14 @@ def _count(chunks, w, m, pairs, begin, n_axes, gas):
             size2 = 0.0
             for a in range(n_axes):
                 size2 += chunks[w, a, t] * chunks[w, a, t]
-            pressing = np.sqrt(size2) / gas.c_max
-            gas.contact[i] += pressing
-            gas.contact[j] += pressing
-            if gas.mean:
-                share = 1.0 / max(1.0, gas.crowd[i], gas.crowd[j])
-                for a in range(n_axes):
-                    chunks[w, a, t] *= share
+            share = pair_share(i, j, kept) if mean else 1.0
             virial = 0.0
             for a in range(n_axes):
-                virial -= chunks[w, n_axes + a, t] * chunks[w, a, t]
-            gas.near[i] += 1.0
-            gas.near[j] += 1.0
-            gas.near_energy[i] += gas.energy[j]
-            gas.near_energy[j] += gas.energy[i]
-            gas.virial[i] += virial
-            gas.virial[j] += virial
+                push = chunks[w, a, t] * share
+                u[i, a] += push
+                u[j, a] -= push
+                virial -= chunks[w, n_axes + a, t] * push
+            add_contact(i, j, size2 * inv_c_max2, virial, work)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -342,7 +342,7 @@ def record(agents, pairs, records, c_max, run, counters, gas):
             for m in range(agents.state.shape[2]):
                 records.state[q_record, q, a, m] = agents.state[i, a, m]
         records.active[q_record, q] = agents.active[i]
-        scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas, i, c_max)) if agents.active[i] else 0.0
+        scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas.observe, gas.kept, i, c_max)) if agents.active[i] else 0.0
         for a in range(n_axes):
             records.control[q_record, q, a] = agents.setpoint[i, a] * scale
     for e in range(pairs.i.shape[0]):

@@ -19,6 +19,7 @@ import unicodedata
 import numpy as np
 from pydantic import field_validator, model_validator
 
+from ..coverage import MAX_CELLS
 from ..formation import generate
 from ..interaction.registry import uses_coupling
 from .tables import (
@@ -63,6 +64,10 @@ MIN_K_P = 1e-150
 #: neighbour search's cells) and per agent (Verlet pairs, found lists, sort order), rounded up.
 WORK_BYTES_PER_AGENT_AXIS = 128
 WORK_BYTES_PER_AGENT = 256
+#: Bytes of the gas's work space per agent and per agent and axis, when it is observed
+#: (:class:`tmem.engine.records.Gas`: 18 numbers, and the walls' push on each axis).
+GAS_BYTES_PER_AGENT = 144
+GAS_BYTES_PER_AGENT_AXIS = 8
 #: Bytes per tracked pair while running (flag, distances, both directions of the edge), rounded up.
 WORK_BYTES_PER_PAIR = 96
 
@@ -128,6 +133,12 @@ class Scenario(StrictModel):
         return self.interaction.radius + (self.interaction.radius if radius is None else radius)
 
     @property
+    def coverage_cell(self) -> float:
+        """Side of the coverage map's cells (m): ``coverage.cell``, default ``R``."""
+        cell = self.coverage.cell if self.coverage is not None else None
+        return self.interaction.radius if cell is None else cell
+
+    @property
     def gas_observed(self) -> bool:
         """Whether the run keeps the gas's totals (:mod:`tmem.engine.gas`): asked for, or needed by the
         mean of pushes, a thermostat, walls or obstacles."""
@@ -169,6 +180,7 @@ class Scenario(StrictModel):
             raise FieldError("agents", f"needs at least 2 agents, got {n}")
         self._check_space()
         self._check_obstacles(axes)
+        self._check_coverage()
         self._check_sampling()
         if self.formation is not None:
             self._check_formation(axes, n)
@@ -184,6 +196,7 @@ class Scenario(StrictModel):
                 raise FieldError("swarm.region", "is required unless space.box is given")
             if len(region) != axes:
                 raise FieldError("swarm.region", per_axis(axes, len(region)))
+            self._check_swarm_room(axes)
         if self.simulation.record_agents is not None:
             for k, a in enumerate(self.simulation.record_agents):
                 if not 0 <= a < n:
@@ -196,7 +209,23 @@ class Scenario(StrictModel):
             )
         self._check_commands(n, pairs)
         self._check_record_size(n, len(pairs))
+        self._check_formation_room(axes, n)
         return self
+
+    def _check_formation_room(self, axes: int, n: int) -> None:
+        """A generated formation starts inside the walls and off every obstacle, jitter included."""
+        f = self.formation
+        if f is None or f.kind == "edges" or not (self.space.walls or self.obstacles):
+            return
+        shape = generate(f.kind, n, f.d_t or self.interaction.d_t, axes, f.bearing)
+        places = shape.positions + np.asarray(f.center or [0.0] * axes)
+        low, high = places.min(axis=0) - f.jitter, places.max(axis=0) + f.jitter
+        if self.space.walls and (np.any(low < 0.0) or np.any(high > np.asarray(self.space.box))):
+            raise FieldError("formation.center", f"places the formation (from {low.tolist()} to {high.tolist()}) "
+                             f"outside the walled box 0..{self.space.box}")  # fmt: skip
+        for o, obstacle in enumerate(self.obstacles):
+            if np.any(np.linalg.norm(places - np.asarray(obstacle.center), axis=1) < obstacle.radius + f.jitter):
+                raise FieldError("formation.center", f"places an agent of the formation inside obstacles[{o}]")
 
     def _check_space(self) -> None:
         space, reach = self.space, self.interaction.reach
@@ -214,6 +243,8 @@ class Scenario(StrictModel):
         for k, obstacle in enumerate(self.obstacles):
             if len(obstacle.center) != axes:
                 raise FieldError(f"obstacles[{k}].center", per_axis(axes, len(obstacle.center)))
+            if self.space.walls and not all(0.0 <= c <= side for c, side in zip(obstacle.center, self.space.box)):
+                raise FieldError(f"obstacles[{k}].center", f"{obstacle.center} lies outside the walled box 0..{self.space.box}")
         box = self.space.box if self.space.walls else None
         for k, agent in enumerate(self.agents):
             place = np.ravel(agent.position) * np.ones(axes)
@@ -222,10 +253,21 @@ class Scenario(StrictModel):
             for o, obstacle in enumerate(self.obstacles):
                 if np.linalg.norm(place - np.asarray(obstacle.center)) < obstacle.radius:
                     raise FieldError(f"agents[{k}].position", f"{place.tolist()} lies inside obstacles[{o}]")
-        if self.swarm is not None:
-            self._check_swarm_room(axes)
-        if self.coverage is not None and not self.space.walls:
+
+    def _check_coverage(self) -> None:
+        """A coverage map needs a walled box, and at most :data:`tmem.coverage.MAX_CELLS` cells."""
+        settings = self.coverage
+        if settings is None:
+            return
+        if not self.space.walls:
             raise FieldError("coverage", "measures a walled box: set space.walls = true and space.box")
+        cells = math.prod(math.ceil(side / self.coverage_cell) for side in self.space.box[:2])
+        if cells > MAX_CELLS:
+            raise FieldError("coverage.cell", f"{self.coverage_cell:g} m cuts the box into {cells:.3g} cells, "
+                             f"at most {MAX_CELLS:.3g}; take larger cells")  # fmt: skip
+        if settings.sensor_radius > 1000.0 * self.coverage_cell:
+            raise FieldError("coverage.sensor_radius", f"must be at most 1000 cells ({1000.0 * self.coverage_cell:g} m), "
+                             f"got {settings.sensor_radius:g}")  # fmt: skip
 
     def _check_swarm_room(self, axes: int) -> None:
         """A swarm in a walled box starts clear of the walls' reach; the obstacles leave it room."""
@@ -279,7 +321,10 @@ class Scenario(StrictModel):
         records = sim.n_steps // sim.record_every + 2
         recorded = n if sim.record_agents is None else len(sim.record_agents)
         kept = records * (recorded * (5 * axes * 8 + 1) + pairs * 32)
-        work = n * (WORK_BYTES_PER_AGENT + axes * WORK_BYTES_PER_AGENT_AXIS) + pairs * WORK_BYTES_PER_PAIR
+        per_agent = WORK_BYTES_PER_AGENT + axes * WORK_BYTES_PER_AGENT_AXIS
+        if self.gas_observed:
+            per_agent += GAS_BYTES_PER_AGENT + axes * GAS_BYTES_PER_AGENT_AXIS
+        work = n * per_agent + pairs * WORK_BYTES_PER_PAIR
         need, limit = kept + work, memory_limit()
         if need > limit:
             field = "swarm.n" if self.swarm is not None else ("formation.n" if self.formation and self.formation.n else "agents")

@@ -1,0 +1,66 @@
+"""Throughput of the gas-N case with the gas's options on, against the plain gas-N, in one run.
+
+The plain case is benchmarks/bench_gas.py's gas-N (2-D periodic box, six neighbours within
+R + R_j on average, repulsion, dt = 0.01 s, 1000 steps, nothing recorded).  The case with the
+options puts the same agents in a walled box of the same side, holds them at their 3 m/s with the
+thermostat and averages their pushes (``interaction.combine = "mean"``), which turns on every gas
+stage: the neighbour counts, walls, thermostat and running totals.  The two alternate, after one
+compile run each; each figure is the median of ``--repeat`` runs, in agent-steps per second, and the
+ratio is that of the medians.
+
+Usage::
+
+    python benchmarks/bench_gas_options.py --n 100000 --repeat 5 [--json benchmarks/results/gas_options.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import statistics
+import time
+from pathlib import Path
+
+from bench_gas import DT, STEPS, gas
+
+import tmem
+from tmem.scenario import with_changes
+
+
+def with_options(n: int, steps: int = STEPS):
+    """gas-N in a walled box with the thermostat and the mean of pushes."""
+    plain = gas(n, steps)
+    return with_changes(plain, {"space.periodic": False, "space.walls": True, "interaction.combine": "mean",
+                                "thermostat": {"rms_velocity": 3.0}})  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, nargs="+", default=[100_000])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--json", type=Path)
+    args = parser.parse_args()
+    rows = []
+    for n in args.n:
+        cases = {"plain": gas(n), "walls + thermostat + mean": with_options(n)}
+        for scenario in cases.values():  # compile, or load from the cache
+            tmem.simulate(with_changes(scenario, {"simulation.duration": 5 * DT, "simulation.record_every": 5}), record=False)
+        seconds = {name: [] for name in cases}
+        for _ in range(args.repeat):  # alternate, so that the machine's load falls on both alike
+            for name, scenario in cases.items():
+                start = time.perf_counter()
+                tmem.simulate(scenario, record=False)
+                seconds[name].append(time.perf_counter() - start)
+        rates = {name: n * STEPS / statistics.median(s) for name, s in seconds.items()}
+        ratio = rates["walls + thermostat + mean"] / rates["plain"]
+        for name, rate in rates.items():
+            print(f"N = {n:>8}  {name:<28} {rate:.3g} agent-steps/s  (runs: {', '.join(f'{s:.2f}' for s in seconds[name])} s)")
+        print(f"N = {n:>8}  ratio (options / plain): {ratio:.3f}")
+        rows.append({"n": n, "rates": rates, "seconds": seconds, "ratio": ratio})
+    if args.json:
+        args.json.write_text(json.dumps({"machine": platform.platform(), "repeat": args.repeat, "rows": rows}, indent=1))
+
+
+if __name__ == "__main__":
+    main()
