@@ -109,16 +109,17 @@ def test_obstacles_on_a_line_of_cells():
 # --- time_to ------------------------------------------------------------------------------------
 
 
-def test_time_to_is_the_first_record_time_reaching_the_share():
+def test_time_to_is_when_the_cell_reaching_the_share_is_entered():
+    """Between records the agent flies 3 cells in 2 s: it enters cell k (k = 1..9) at 2 (k - 1/2) / 3 s."""
     times = [0.0, 2.0, 4.0, 6.0]  # 1 cell, then 3 more a record: 1, 4, 7, 10 cells of 100
     cov = _run([[[0.5, 0.5]], [[3.5, 0.5]], [[6.5, 0.5]], [[9.5, 0.5]]], times=times)
     assert cov.share.tolist() == [0.01, 0.04, 0.07, 0.1]
     assert cov.time_to(0.0) == 0.0
     assert cov.time_to(0.01) == 0.0
-    assert cov.time_to(0.02) == 2.0
-    assert cov.time_to(0.04) == 2.0
-    assert cov.time_to(0.05) == 4.0
-    assert cov.time_to(0.1) == 6.0
+    assert cov.time_to(0.02) == pytest.approx(1.0 / 3.0)
+    assert cov.time_to(0.04) == pytest.approx(5.0 / 3.0)
+    assert cov.time_to(0.05) == pytest.approx(7.0 / 3.0)
+    assert cov.time_to(0.1) == pytest.approx(17.0 / 3.0)
     assert cov.time_to(0.11) is None
     assert cov.time_to(1.0) is None
     with pytest.raises(ValueError, match="^share:"):
