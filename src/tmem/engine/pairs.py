@@ -161,7 +161,7 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
         _synchronise(e, r, dist, entering, d, known, pairs, law, params, n_axes, agents.setpoint)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _count_pair(e, agents, pairs, law, params, box, gas):
     """For the gas (:mod:`tmem.engine.gas`): pair ``e``, if within reach, counted as the neighbour
     stage counts its pairs; with no coupling flag (the tracked pairs of a small swarm) it is a plain
