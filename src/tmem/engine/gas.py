@@ -37,22 +37,8 @@ from ..scenario import ThermostatParams
 from ..space import nearest_image
 from .records import Gas
 
-#: The running totals of each agent, in the columns of ``Gas.totals``: momentum given to the box's
-#: walls per unit mass (m/s), the same weighted by the agent's distance from the wall (m^2/s), the
-#: virial of the pushes integrated over time (m^2/s), encounters (neighbours that came within reach:
-#: the rises of the agent's count of them, step to step), path flown (m), and steps spent beyond a
-#: wall or inside an obstacle.
-TOTALS = ("wall_momentum", "wall_virial", "virial", "encounters", "path", "breaches")
-WALL_MOMENTUM, WALL_VIRIAL, VIRIAL_TOTAL, ENCOUNTERS, PATH, BREACHES = range(len(TOTALS))
-#: Columns of ``Gas.work``, one row per agent, cleared at each step: neighbours within reach, their
-#: pushes' sizes over ``c_max``, their energies, the agent's virial (rad m), its ``|V|^2``, its
-#: energy, the size of the box walls' pushes (rad) and their moment about the walls (rad m).
-NEAR, CONTACT, NEAR_ENERGY, VIRIAL, SPEED2, ENERGY, WALL_PUSH, WALL_MOMENT = range(8)
-#: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
-#: step before, contacts at the step before (C1), the energy its pushes held (T2), its tilt limit.
-NEAR_BEFORE, CROWD, STORED, LIMIT = range(4)
-#: Long name and units of each column of a record (:data:`TOTALS` then :data:`SNAPSHOT`), running
-#: totals over every agent since the start, per unit agent mass.
+#: Long name and units of each column of a record, per unit agent mass: first the running totals
+#: of every agent since the start (:data:`TOTALS`), then what a record adds (:data:`SNAPSHOT`).
 COLUMNS = {
     "wall_momentum": ("momentum given to the walls", "m s-1"),
     "wall_virial": ("momentum given to the walls times the distance from them", "m2 s-1"),
@@ -64,10 +50,24 @@ COLUMNS = {
     "flying": ("agents flying", "1"),
     "moment": ("sum of (P - box centre) . V over walled axes", "m2 s-1"),
 }
+#: The running totals of each agent, the columns of ``Gas.totals``: momentum given to the box's walls
+#: (m/s), the same weighted by the agent's distance from the wall (m^2/s), the virial of the pushes
+#: integrated over time (m^2/s), encounters (neighbours that came within reach: the rises of the
+#: agent's count of them, step to step), path flown (m), and steps spent beyond a wall or inside an
+#: obstacle.
+TOTALS = tuple(COLUMNS)[:6]
+WALL_MOMENTUM, WALL_VIRIAL, VIRIAL_TOTAL, ENCOUNTERS, PATH, BREACHES = range(len(TOTALS))
 #: What a record holds besides the totals summed over agents: the sum of ``|V|^2`` of the flying
 #: agents, their number, and ``sum_i (P_i - c) . V_i`` over the walled axes (``c`` the box's centre;
 #: the virial theorem's boundary term, m^2/s).
-SNAPSHOT = ("speed2_sum", "flying", "moment")
+SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
+#: Columns of ``Gas.work``, one row per agent, cleared at each step: neighbours within reach, their
+#: pushes' squared sizes over ``c_max^2``, their energies, the agent's virial (rad m), its ``|V|^2``,
+#: its energy, the size of the box walls' pushes (rad) and their moment about the walls (rad m).
+NEAR, CONTACT, NEAR_ENERGY, VIRIAL, SPEED2, ENERGY, WALL_PUSH, WALL_MOMENT = range(8)
+#: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
+#: step before, contacts at the step before (C1), the energy its pushes held (T2), its tilt limit.
+NEAR_BEFORE, CROWD, STORED, LIMIT = range(4)
 
 
 @numba.njit(cache=True, inline="always")
