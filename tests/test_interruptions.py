@@ -186,6 +186,21 @@ def test_interrupted_run_leaves_the_earlier_output_or_a_whole_new_one(long_run, 
     assert sorted(p.name for p in out.iterdir() if p.name != ".tmem-output.json") == listed_files(out)
 
 
+def test_a_signal_after_the_command_is_done_keeps_its_exit_status():
+    """Ctrl-C or SIGTERM arriving while Python shuts down, the output already in place, is not the exit status."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        script = (
+            "import os, sys\n"
+            "from tmem.cli import main\n"
+            "sys.argv = ['tmem', '--help']\n"
+            f"try:\n    main()\nfinally:\n    os.kill(os.getpid(), {int(signum)})\n"
+        )
+        env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+        done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, (signum, done.returncode, done.stderr[-500:])
+        assert "Traceback" not in done.stderr
+
+
 # --- tmem animate
 
 

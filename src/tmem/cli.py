@@ -244,7 +244,7 @@ def sweep_command(
 
 def main() -> None:
     """Entry point of the ``tmem`` console script."""
-    from .outputs import handle_termination
+    from .outputs import handle_termination, ignore_interrupts
 
     handle_termination()  # SIGTERM and SIGHUP as Ctrl-C: interrupted writes leave nothing behind
     try:
@@ -252,3 +252,5 @@ def main() -> None:
     except KeyboardInterrupt:
         console.print("interrupted; no output was written")
         sys.exit(130)
+    finally:
+        ignore_interrupts()  # the work is over: a signal while Python shuts down must not become the exit status

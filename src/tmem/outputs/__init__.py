@@ -62,7 +62,7 @@ from .locking import lock
 from .manifest import MANIFEST, OutputError, check_directory
 from .names import partial_name, remove_leftovers
 from .replace import ANIMATE_MARK, check_file, create_directory, mark_directory, replace_directory, replace_file, write_atomically
-from .signals import handle_termination
+from .signals import handle_termination, ignore_interrupts
 
 __all__ = [
     "ANIMATE_MARK",
@@ -72,6 +72,7 @@ __all__ = [
     "check_file",
     "create_directory",
     "handle_termination",
+    "ignore_interrupts",
     "lock",
     "mark_directory",
     "partial_name",

@@ -26,6 +26,21 @@ def handle_termination() -> None:
             signal.signal(signum, _raise_interrupt)
 
 
+def ignore_interrupts() -> None:
+    """Ignore Ctrl-C, SIGTERM and SIGHUP from now on: called once a command's work and its exit status are settled.
+
+    Python restores the default handlers while it shuts down, so a signal
+    arriving then would end the process by that signal and replace the exit
+    status the command had already chosen.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        signum = getattr(signal, name, None)
+        if signum is not None:
+            signal.signal(signum, signal.SIG_IGN)
+
+
 @contextmanager
 def _signals_held() -> Iterator[None]:
     """Hold back Ctrl-C, SIGTERM and SIGHUP for the block, then deliver the first that came."""
