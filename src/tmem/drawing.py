@@ -102,31 +102,33 @@ class Chosen:
     note: str
 
 
-def first_agents(total: int, at_most: int = MAX_LINES) -> Chosen:
+def first_agents(total: int, at_most: int | None = None) -> Chosen:
     """The first ``at_most`` of ``total`` recorded agents.
 
     Parameters
     ----------
     total : int
         Agents recorded.
-    at_most : int
-        Most drawn.
+    at_most : int, optional
+        Most drawn; default :data:`MAX_LINES`.
     """
+    at_most = MAX_LINES if at_most is None else at_most
     if total <= at_most:
         return Chosen(np.arange(total), total, "")
     return Chosen(np.arange(at_most), total, f"{at_most} of {total} agents: the first {at_most} recorded")
 
 
-def closest_pairs(min_distance: np.ndarray, at_most: int = MAX_LINES) -> Chosen:
+def closest_pairs(min_distance: np.ndarray, at_most: int | None = None) -> Chosen:
     """Every pair, or the ``at_most`` pairs that came closest (the ones that interacted most).
 
     Parameters
     ----------
     min_distance : ndarray, shape (pairs,)
         Each pair's smallest distance over the run (m).
-    at_most : int
-        Most drawn.
+    at_most : int, optional
+        Most drawn; default :data:`MAX_LINES`.
     """
+    at_most = MAX_LINES if at_most is None else at_most
     total = len(min_distance)
     if total <= at_most:
         return Chosen(np.arange(total), total, "")
