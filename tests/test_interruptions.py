@@ -229,7 +229,7 @@ def whole_png(data: bytes) -> bool:
     return data.startswith(b"\x89PNG\r\n\x1a\n") and data.endswith(b"IEND\xaeB`\x82")
 
 
-@pytest.mark.parametrize("name", SIGNALS)
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGKILL"])  # Ctrl-C: tests/test_plot_command.py, in the process
 def test_interrupted_plot_leaves_the_old_figures_or_whole_new_ones(run_2d, tmp_path, name):
     signum = SIGNALS[name]
     run = tmp_path / "run"
