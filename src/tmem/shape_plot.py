@@ -9,7 +9,7 @@
     says which are drawn.
 ``shape.png`` (2-D and 3-D runs)
     Every recorded agent and every pair between them at the moments of :func:`moments`, side by
-    side on one scale: coupled pairs (``F_en = 1``) as solid lines coloured by their strain
+    side in views of one size and scale, each centred on the agents at its moment: coupled pairs (``F_en = 1``) as solid lines coloured by their strain
     ``|P_j - P_i| / d_t - 1``, uncoupled pairs as dashed grey lines, flying agents as dots,
     numbered when there are at most :data:`tmem.drawing.MAX_NUMBERED`.  The strain colour scale is
     fitted to the run: symmetric about 0, reaching the largest ``|strain|`` of a coupled pair over
@@ -49,9 +49,17 @@ def _limits(points: np.ndarray, trajectory: Trajectory) -> tuple[np.ndarray, np.
     box = trajectory.scenario.space.box
     if trajectory.scenario.space.walls and box is not None:
         points = np.concatenate([points, np.zeros((1, points.shape[1])), [box]])
-    low, high = (points.min(axis=0), points.max(axis=0)) if len(points) else (np.zeros(2), np.zeros(2))
+    low, high = (points.min(axis=0), points.max(axis=0)) if len(points) else (np.zeros(points.shape[1]),) * 2
     margin = max(trajectory.scenario.interaction.radius, 0.02 * float((high - low).max(initial=0.0)))
     return low - margin, high + margin
+
+
+def _windows(flying: np.ndarray, trajectory: Trajectory) -> list[tuple[np.ndarray, np.ndarray]]:
+    """One view per moment (``flying``: moment, agent, axis), all of one size, each centred on that
+    moment's agents: the formation as large as the largest moment allows, wherever it has flown."""
+    bounds = [_limits(points, trajectory) for points in flying]
+    size = np.max([high - low for low, high in bounds], axis=0)
+    return [(0.5 * (low + high - size), 0.5 * (low + high + size)) for low, high in bounds]
 
 
 def _plane(ax, trajectory: Trajectory, low: np.ndarray, high: np.ndarray) -> None:
@@ -195,7 +203,7 @@ def _draw_moment(ax, trajectory: Trajectory, moment: tuple[str, int], pairs: tup
         else:
             ax.add_collection(collection, autolim=False)
     shown = np.flatnonzero(np.isfinite(points).all(axis=1))
-    ax.scatter(*points[shown, :dims].T, s=18, c=[colors[q] for q in shown], zorder=3)
+    ax.scatter(*points[shown, :dims].T, s=18 if len(points) <= 200 else 4, c=[colors[q] for q in shown], zorder=3)
     if not three:
         _number(ax, trajectory, points, shown)
     ax.set_title(f"{name}, t = {trajectory.time[record]:.1f} s")
@@ -211,14 +219,17 @@ def shape_figure(trajectory: Trajectory):
     """
     n_axes = trajectory.scenario.space.axes
     shown = moments(trajectory)
-    fig = Figure(figsize=(4.2 * len(shown) + 1.2, 4.8 if n_axes == 2 else 5.2), layout="constrained")
+    flying = _flying_positions(trajectory)[[record for _, record in shown]]
+    windows = _windows(flying, trajectory)
+    size = windows[0][1] - windows[0][0]
+    panel = 4.2  # inches wide; as high as the view is in the plane, within reason
+    height = 5.2 if n_axes == 3 else 1.8 + float(np.clip(panel * size[1] / size[0], 2.0, 6.0))
+    fig = Figure(figsize=(panel * len(shown) + 1.2, height), layout="constrained")
     pairs = _pair_columns(trajectory)
     norm = strain_norm(strain_limit(strain(trajectory.pair_distance, trajectory.d_t)[trajectory.flag == 1]))
     n_agents = trajectory.state.shape[1]
     colors = agent_colors(trajectory.agents)[0] if n_agents <= MAX_LEGEND else ["0.25"] * n_agents
-    flying = _flying_positions(trajectory)[[record for _, record in shown]]
-    low, high = _limits(flying.reshape(-1, n_axes), trajectory)
-    for k, (name, record) in enumerate(shown):
+    for k, ((name, record), (low, high)) in enumerate(zip(shown, windows)):
         ax = fig.add_subplot(1, len(shown), k + 1, projection="3d" if n_axes == 3 else None, label=name)
         if n_axes == 3:
             _space(ax, low, high)
@@ -227,5 +238,6 @@ def shape_figure(trajectory: Trajectory):
         _draw_moment(ax, trajectory, (name, record), pairs, norm, colors)
     if len(pairs[0]):
         fig.colorbar(ScalarMappable(norm, strain_colormap()), ax=fig.axes, label=STRAIN_LABEL, shrink=0.8)
-    fig.suptitle(run_title(trajectory, f"{n_agents} agents and {len(pairs[0])} pairs"), parse_math=False)
+    counted = f"{n_agents} agents" + (f" and {len(pairs[0])} pairs" if len(pairs[0]) else "")
+    fig.suptitle(run_title(trajectory, counted), parse_math=False)
     return fig
