@@ -223,7 +223,7 @@ def shape_figure(trajectory: Trajectory):
     windows = _windows(flying, trajectory)
     size = windows[0][1] - windows[0][0]
     panel = 4.2  # inches wide; as high as the view is in the plane, within reason
-    height = 5.2 if n_axes == 3 else 1.8 + float(np.clip(panel * size[1] / size[0], 2.0, 6.0))
+    height = 5.8 if n_axes == 3 else 1.8 + float(np.clip(panel * size[1] / size[0], 2.0, 6.0))
     fig = Figure(figsize=(panel * len(shown) + 1.2, height), layout="constrained")
     pairs = _pair_columns(trajectory)
     norm = strain_norm(strain_limit(strain(trajectory.pair_distance, trajectory.d_t)[trajectory.flag == 1]))
