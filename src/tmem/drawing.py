@@ -188,6 +188,26 @@ def agent_colors(indices: np.ndarray) -> tuple[list, ScalarMappable | None]:
     return list(mappable.to_rgba(numbers)), mappable
 
 
+def agents_legend(ax, mappable: ScalarMappable | None, extra=()) -> None:
+    """A legend entry per agent when they are few; else a colour bar of agent numbers and a legend of the rest.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        The axes whose lines are labelled ``agent 1``, ``agent 2`` ...
+    mappable : ScalarMappable or None
+        The colour bar's mappable of :func:`agent_colors` (None: a legend entry each).
+    extra : sequence of Artist
+        Further legend entries (markers of the start and end).
+    """
+    handles = [h for h in ax.get_legend_handles_labels()[0] if mappable is None or not h.get_label().startswith("agent ")]
+    handles += list(extra)
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=8)
+    if mappable is not None:
+        ax.figure.colorbar(mappable, ax=ax.figure.axes, label="agent", shrink=0.8)
+
+
 def strain(distance: np.ndarray, d_t: np.ndarray) -> np.ndarray:
     """The strain ``|P_j - P_i| / d_t - 1`` of pairs.
 

@@ -30,7 +30,9 @@ import numpy as np
 from matplotlib.figure import Figure  # not pyplot: writing a file needs no window and no figure manager
 
 from . import metrics
-from .drawing import MAX_LEGEND, agent_colors, agent_label, closest_pairs, draw_region, first_agents, pair_label, run_title
+from .drawing import (
+    MAX_LEGEND, agent_colors, agent_label, agents_legend, closest_pairs, draw_region, first_agents, pair_label, run_title,
+)  # fmt: skip
 from .engine import Trajectory
 from .observables import temperature
 from .outputs import check_directory, replace_directory, update_files
@@ -53,16 +55,6 @@ def _mark_events(ax, trajectory: Trajectory) -> None:
         color, style = _EVENT_STYLE[e.kind]
         ax.axvline(e.time, color=color, linestyle=style, linewidth=1, label=None if e.kind in seen else e.kind)
         seen.add(e.kind)
-
-
-def _lines_legend(ax, fig, mappable, label: str) -> None:
-    """A legend when each line has its own entry; a colour bar of agent numbers when they are too many."""
-    if mappable is None:
-        ax.legend(loc="best", fontsize=8)
-    else:
-        ax.legend(handles=[h for h in ax.get_legend_handles_labels()[0] if not h.get_label().startswith("agent ")],
-                  loc="best", fontsize=8)  # fmt: skip
-        fig.colorbar(mappable, ax=ax, label=label)
 
 
 def velocity_figure(trajectory: Trajectory):
@@ -93,7 +85,7 @@ def velocity_figure(trajectory: Trajectory):
     ax.set_ylabel("velocity V, m/s" if one_axis else "speed |V|, m/s")
     ax.set_title(run_title(trajectory, chosen.note), parse_math=False)
     ax.grid(alpha=0.3)
-    _lines_legend(ax, fig, mappable, "agent")
+    agents_legend(ax, mappable)
     return fig
 
 

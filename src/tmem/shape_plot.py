@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .drawing import (
-    MAX_LEGEND, MAX_NUMBERED, STRAIN_LABEL, agent_colors, agent_label, columns_of, draw_region, first_agents,
+    MAX_LEGEND, MAX_NUMBERED, STRAIN_LABEL, agent_colors, agent_label, agents_legend, columns_of, draw_region, first_agents,
     run_title, strain, strain_colormap, strain_limit, strain_norm,
 )  # fmt: skip
 from .engine import Trajectory
@@ -133,14 +133,11 @@ def paths_figure(trajectory: Trajectory):
             view.scatter(*ends[:, dims].T, s=16, c=colors)
         _number(ax, trajectory, ends, np.arange(len(chosen.index)))
     fig.suptitle(run_title(trajectory, chosen.note), parse_math=False)
-    handles = ax.get_legend_handles_labels()[0] if mappable is None else []
-    if n_axes > 1:
-        handles += [Line2D([], [], ls="", marker="o", mfc="none", mec="k", label="start"),
-                    Line2D([], [], ls="", marker="o", color="k", ms=4, label="end")]  # fmt: skip
-    if handles:
-        ax.legend(handles=handles, loc="best", fontsize=8)
-    if mappable is not None:
-        fig.colorbar(mappable, ax=fig.axes, label="agent", shrink=0.8)
+    markers = [] if n_axes == 1 else [
+        Line2D([], [], ls="", marker="o", mfc="none", mec="k", label="start"),
+        Line2D([], [], ls="", marker="o", color="k", ms=4, label="end"),
+    ]  # fmt: skip
+    agents_legend(ax, mappable, markers)
     return fig
 
 
