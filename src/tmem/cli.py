@@ -262,7 +262,10 @@ def plot_command(
         paths = redraw(run_dir, out)
     except (ValueError, OSError) as exc:
         _fail(str(exc))
-    _say(f"written {', '.join(p.name for p in paths)} to {paths[0].parent if paths else out or run_dir}/")
+    if not paths:
+        _say(f"{run_dir}: the run recorded nothing to draw")
+        return
+    _say(f"written {', '.join(p.name for p in paths)} to {paths[0].parent}/")
 
 
 @app.command("sweep")
