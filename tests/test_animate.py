@@ -1,4 +1,4 @@
-"""Animation of a 2-D run, from small synthetic ``trajectory.nc`` files."""
+"""Animation of a 2-D or 3-D run, from small synthetic ``trajectory.nc`` files."""
 
 import subprocess
 import sys
@@ -9,7 +9,9 @@ import pytest
 import xarray as xr
 from PIL import Image, ImageChops
 
-from tmem.animate import _load, animate
+from tmem.animate import animate
+from tmem.animate.frames import read_frames
+from tmem.animate.scene import positions, scene, update
 
 SCENARIO = 'name = "synthetic"\n\n[interaction]\nradius = 20.0\nd_t = 35.0\n'
 
@@ -77,7 +79,7 @@ def test_gas_without_pairs_active_or_d_t(tmp_path):
 def test_recorded_subset_maps_pairs_by_agent_index(tmp_path):
     # Agents 7, 3, 5 recorded; the pair with agent 9 (not recorded) is left out.
     run = _write(tmp_path, agents=(7, 3, 5), pairs=((3, 7), (5, 9), (7, 5)))
-    drawn = _load(run, max_frames=10)
+    drawn = read_frames(run, max_frames=10)
     assert drawn.col_i.tolist() == [1, 0] and drawn.col_j.tolist() == [0, 2]
     assert drawn.flag.shape == (10, 2)
     assert drawn.d_t.tolist() == [35.0, 35.0]
@@ -85,13 +87,44 @@ def test_recorded_subset_maps_pairs_by_agent_index(tmp_path):
     assert len(_frames(animate(run, max_frames=10, dpi=40))) == 10
 
 
-@pytest.mark.parametrize("n_axes, words", [(1, "1 axis"), (3, "3 axes")])
-def test_refuses_runs_that_are_not_2d(tmp_path, n_axes, words):
-    run = _write(tmp_path, n_axes=n_axes)
+def test_refuses_runs_on_one_axis(tmp_path):
+    run = _write(tmp_path, n_axes=1)
     with pytest.raises(ValueError) as error:
         animate(run)
-    assert str(error.value) == f"animate: the run has {words}; only 2-D runs can be animated"
+    assert str(error.value) == "animate: the run has 1 axis; only 2-D and 3-D runs can be animated"
     assert not (run / "animation.gif").exists()
+
+
+def test_3d_run_is_drawn_in_3d_beside_its_projection(tmp_path):
+    run = _write(tmp_path, n_axes=3)
+    frames = read_frames(run, max_frames=10)
+    shown, cross = positions(frames)
+    fig, moving = scene(frames, shown, dpi=40)
+    assert [ax.name for ax in fig.axes].count("3d") == 1
+    assert any(ax.get_title() == "projection on (x, y)" for ax in fig.axes)
+    update(moving, frames, 9, shown, cross, True)
+    flying = frames.active[9]
+    np.testing.assert_allclose(moving["space dots"].get_offsets()[flying], frames.pos[9, flying, :2])
+    assert len(moving["space coupled"].get_array()) == 1  # the pair, coupled from the middle on
+    assert len(_frames(animate(run, max_frames=10, dpi=40))) == 10
+
+
+def test_agents_are_numbered_from_one_as_in_the_paper(tmp_path):
+    frames = read_frames(_write(tmp_path, agents=(7, 3, 5), pairs=((3, 7),)), max_frames=5)
+    fig, _ = scene(frames, positions(frames)[0], dpi=40)
+    assert sorted(t.get_text() for t in fig.axes[0].texts if t.get_text().isdigit()) == ["4", "6", "8"]
+
+
+def test_strain_scale_is_fitted_to_the_coupled_pairs_drawn(tmp_path):
+    ds = _dataset()
+    run = _write(tmp_path)
+    frames = read_frames(run, max_frames=400)
+    _, moving = scene(frames, positions(frames)[0], dpi=40)
+    P = ds["P"].values
+    coupled = ds["F_en"].values[:, 0] == 1
+    strain = np.linalg.norm(P[coupled, 1] - P[coupled, 0], axis=1) / 35.0 - 1
+    assert moving["coupled"].norm.vmax == pytest.approx(np.abs(strain).max(), rel=1e-12)
+    assert moving["coupled"].norm.vmin == -moving["coupled"].norm.vmax
 
 
 def test_missing_trajectory(tmp_path):

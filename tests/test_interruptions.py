@@ -237,6 +237,39 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     assert gif.exists() and partials(run, "animation.gif") == []
 
 
+# --- tmem plot
+
+
+def whole_png(data: bytes) -> bool:
+    return data.startswith(b"\x89PNG\r\n\x1a\n") and data.endswith(b"IEND\xaeB`\x82")
+
+
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGKILL"])  # Ctrl-C: tests/test_plot_command.py, in the process
+def test_interrupted_plot_leaves_the_old_figures_or_whole_new_ones(run_2d, tmp_path, name):
+    signum = SIGNALS[name]
+    run = tmp_path / "run"
+    shutil.copytree(run_2d, run)
+    figures = sorted(p.name for p in run.glob("*.png"))
+    for figure in figures:
+        (run / figure).write_bytes(b"old")
+    command = Command("plot", run, cwd=tmp_path)
+    reached = moment(command, "writing", lambda: bool(partials(run, "figures")))
+    if reached:
+        command.send(signum)
+    code, output = command.finish()
+    assert reached, f"plot ended before it wrote: {output}"
+    check_exit(code, output, signum, "writing")
+    after = [(run / figure).read_bytes() for figure in figures]
+    if signum != signal.SIGKILL:  # all at once: the renames are not interrupted
+        assert all(a == b"old" for a in after) or all(whole_png(a) for a in after), output
+        assert partials(run, "figures") == []
+        return
+    assert all(a == b"old" or whole_png(a) for a in after)
+    result = CliRunner().invoke(app, ["plot", str(run)])
+    assert result.exit_code == 0, result.output
+    assert partials(run, "figures") == [] and all(whole_png((run / f).read_bytes()) for f in figures)
+
+
 # --- tmem sweep
 
 

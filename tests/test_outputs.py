@@ -29,12 +29,12 @@ def fig9_run(tmp_path_factory):
 
 def test_run_writes_the_promised_files(fig9_run):
     assert sorted(p.name for p in fig9_run.iterdir()) == [
-        ".tmem-output.json", "distance.png", "summary.json", "trajectory.nc", "velocity.png",
+        ".tmem-output.json", "distance.png", "paths.png", "summary.json", "trajectory.nc", "velocity.png",
     ]  # fmt: skip
     manifest = json.loads((fig9_run / ".tmem-output.json").read_text())
     assert manifest["command"] == "run"
-    assert manifest["files"] == ["distance.png", "summary.json", "trajectory.nc", "velocity.png"]
-    for png in ("distance.png", "velocity.png"):
+    assert manifest["files"] == ["distance.png", "paths.png", "summary.json", "trajectory.nc", "velocity.png"]
+    for png in ("distance.png", "paths.png", "velocity.png"):
         assert (fig9_run / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

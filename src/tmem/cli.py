@@ -1,4 +1,4 @@
-"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` a run, ``sweep`` many.
+"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` or ``plot`` a run, ``sweep`` many.
 
 User mistakes (a bad scenario, an unusable output directory) end with one
 line on standard error naming the field and the reason, exit status 2 and no
@@ -16,14 +16,56 @@ import time
 from pathlib import Path
 
 import typer
+from typer.core import TyperGroup
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Column, Table
 from rich.text import Text
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__.split("\n")[0])
+
+
+def _untyped_flags(command, ctx) -> None:
+    """Show flags (``--help``, ``--version``) in help without a type: Typer would write ``--help <bool>``."""
+    for param in command.get_params(ctx):
+        if getattr(param, "is_flag", False):
+            param.metavar = ""
+
+
+class _Commands(TyperGroup):
+    """Typer's group of commands, each one's flags shown without a type in its help."""
+
+    def get_command(self, ctx, cmd_name):
+        command = super().get_command(ctx, cmd_name)
+        if command is not None:
+            _untyped_flags(command, ctx)
+        return command
+
+    def format_help(self, ctx, formatter):
+        _untyped_flags(self, ctx)
+        super().format_help(ctx, formatter)
+
+
+app = typer.Typer(
+    cls=_Commands, add_completion=False, no_args_is_help=True,
+    help="Run a scenario, reproduce the paper, animate or plot a run, sweep many.",
+)  # fmt: skip
 console = Console(stderr=True)
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        _say(f"tmem {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True, help="Print the version and exit."),
+) -> None:
+    """Run a scenario, reproduce the paper, animate or plot a run, sweep many."""
 
 #: Runs expected to take less than this (s) show no progress bar.
 PROGRESS_AFTER = 1.0
@@ -98,11 +140,13 @@ def _summary_table(rows: dict[str, dict]) -> Table:
 
 @app.command()
 def run(
-    scenario: Path = typer.Argument(..., help="Scenario TOML file (see examples/)."),
-    out: Path = typer.Option(..., "--out", "-o", help="Output directory (replaced if it holds an earlier run)."),
+    scenario: Path = typer.Argument(..., metavar="SCENARIO", help="Scenario TOML file (see examples/)."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output directory; replaced only if it holds an earlier run."),
 ) -> None:
     """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT.
 
+    The figures: velocity.png, paths.png and, where the run has them, distance.png,
+    formation.png, shape.png, gas.png, field.png.
     \f
     Parameters
     ----------
@@ -131,10 +175,12 @@ def run(
 
 @app.command()
 def paper(
-    out: Path = typer.Option(Path("out/paper"), "--out", "-o", help="Output directory."),
+    out: Path = typer.Option(Path("out/paper"), "--out", "-o", help="Output directory; replaced only if it holds an earlier paper."),
 ) -> None:
     """Reproduce the paper's Figs. 5, 7 and 9 into OUT/fig5, OUT/fig7, OUT/fig9 and OUT/report.md.
 
+    Each figure's folder holds a run as tmem run writes it; the report's reruns under the paper's
+    further work go to OUT/fig7-energy, OUT/fig9-energy, OUT/fig7-sync and OUT/fig9-sync.
     \f
     Parameters
     ----------
@@ -158,13 +204,16 @@ def paper(
 
 @app.command("animate")
 def animate_command(
-    run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run` (2-D runs)."),
-    out: Path = typer.Option(None, "--out", "-o", help="Animation file (.gif, or .mp4 with ffmpeg); default RUN_DIR/animation.gif."),
-    fps: int = typer.Option(20, help="Frames per second."),
-    max_frames: int = typer.Option(400, help="Most frames; the recorded times are thinned evenly."),
+    run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run directory written by tmem run (a 2-D or 3-D run)."),
+    out: Path = typer.Option(
+        None, "--out", "-o", show_default="RUN_DIR/animation.gif", help="Animation file: .gif, or .mp4 with ffmpeg."
+    ),
+    fps: int = typer.Option(20, help="Frames per second of the animation."),
+    max_frames: int = typer.Option(400, help="Most frames drawn; the recorded times are thinned evenly to this many."),
 ) -> None:
-    """Animate a 2-D run: agents, interaction circles, coupled pairs and a clock.
+    """Animate a run: agents, interaction circles, coupled pairs coloured by strain, and a clock.
 
+    A 3-D run is drawn as a 3-D view beside its projection on (x, y).
     \f
     Parameters
     ----------
@@ -189,15 +238,46 @@ def animate_command(
     _say(f"written {path}")
 
 
+@app.command("plot")
+def plot_command(
+    run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run directory written by tmem run, or a run of tmem paper."),
+    out: Path = typer.Option(
+        None, "--out", "-o", show_default="RUN_DIR", help="Directory for the figures; replaced only if it holds earlier ones."
+    ),
+) -> None:
+    """Draw a saved run's figures again, from its trajectory.nc and summary.json.
+
+    The figures are those tmem run writes; in RUN_DIR they replace their namesakes all at once.
+    \f
+    Parameters
+    ----------
+    run_dir : Path
+        A run directory written by ``tmem run``.
+    out : Path or None
+        Directory for the figures; default ``RUN_DIR``.
+    """
+    from .plot import redraw
+
+    try:
+        paths = redraw(run_dir, out)
+    except (ValueError, OSError) as exc:
+        _fail(str(exc))
+    if not paths:
+        _say(f"{run_dir}: the run recorded nothing to draw")
+        return
+    _say(f"written {', '.join(p.name for p in paths)} to {paths[0].parent}/")
+
+
 @app.command("sweep")
 def sweep_command(
-    sweep_file: Path = typer.Argument(..., help="Sweep TOML file (see examples/sweeps/ and docs/sweeps.md)."),
+    sweep_file: Path = typer.Argument(..., metavar="SWEEP_FILE", help="Sweep TOML file (see examples/sweeps/ and docs/sweeps.md)."),
     out: Path = typer.Option(..., "--out", "-o", help="Output directory; run again to resume an interrupted sweep."),
-    scheduler: str = typer.Option(None, help="Address of an existing Dask scheduler; default: a local cluster."),
-    workers: str = typer.Option(None, metavar="N", help="Worker processes of the local cluster; default: one per core."),
+    scheduler: str = typer.Option(None, show_default="a local cluster", help="Address of an existing Dask scheduler."),
+    workers: str = typer.Option(None, metavar="N", show_default="one per core", help="Worker processes of the local cluster."),
 ) -> None:
     """Run every case of SWEEP_FILE on Dask; write results.parquet, summary.md and figures to OUT.
 
+    OUT also holds sweep.toml and sweep.json, and parts/ while cases run (docs/sweeps.md).
     \f
     Parameters
     ----------

@@ -1,13 +1,15 @@
 """Output directories and files: when tmem may write or replace them, and how it survives interruptions.
 
 Every command that writes (``tmem run``, ``tmem paper``, ``tmem animate``,
-``tmem sweep``) goes through this package:
+``tmem sweep``, ``tmem plot``) goes through this package:
 
 * :mod:`tmem.outputs.manifest`: the manifest, and which directory a command
   may write (the rule below);
 * :mod:`tmem.outputs.names`: temporary names, and what killed processes left;
 * :mod:`tmem.outputs.replace`: directories and files written under a
   temporary name and renamed into place when complete;
+* :mod:`tmem.outputs.update`: files written again into an existing output
+  all at once (``tmem plot`` into a run directory);
 * :mod:`tmem.outputs.locking`: the lock of a directory a sweep writes into;
 * :mod:`tmem.outputs.signals`: SIGTERM as Ctrl-C, and signals held back while
   an output is renamed into place.
@@ -15,13 +17,13 @@ Every command that writes (``tmem run``, ``tmem paper``, ``tmem animate``,
 The rule for output directories
 -------------------------------
 Each command marks the directory it writes with ``.tmem-output.json``, a
-manifest naming the command and (for ``run`` and ``paper``) every file it
-wrote.  A command writes to ``--out DIR`` only when:
+manifest naming the command and (for ``run``, ``paper`` and ``plot``) every
+file it wrote.  A command writes to ``--out DIR`` only when:
 
 1. DIR does not exist, or is empty: it is created;
 2. DIR holds an output of the *same* command (its manifest names that
-   command) and nothing the manifest does not list: ``tmem run`` and
-   ``tmem paper`` replace it whole; ``tmem sweep`` resumes it, and only if it
+   command) and nothing the manifest does not list: ``tmem run``,
+   ``tmem paper`` and ``tmem plot --out`` replace it whole; ``tmem sweep`` resumes it, and only if it
    holds the same sweep (it never replaces one).
 
 Anything else is refused with one line that says what is there: another
@@ -63,6 +65,7 @@ from .manifest import MANIFEST, OutputError, check_directory
 from .names import partial_name, remove_leftovers
 from .replace import ANIMATE_MARK, check_file, create_directory, mark_directory, replace_directory, replace_file, write_atomically
 from .signals import handle_termination, ignore_interrupts
+from .update import update_files
 
 __all__ = [
     "ANIMATE_MARK",
@@ -79,5 +82,6 @@ __all__ = [
     "remove_leftovers",
     "replace_directory",
     "replace_file",
+    "update_files",
     "write_atomically",
 ]
