@@ -1,0 +1,345 @@
+"""What the viewer shows of a run, read from the run directory and thinned to fit one page.
+
+:func:`read_view` reads ``trajectory.nc`` and ``summary.json`` (as
+:func:`tmem.io.write_run_files` writes them) into a :class:`View`: the agents
+and recorded times kept, the positions and speeds at those times, each agent's
+state (not yet flying, flying, removed), the formation edges between kept
+agents with their strain ``(|d| - d_t) / d_t`` and flag ``F_en``, and the
+series of the linked panels (RMS velocity, pair distances).
+
+The state variables are named by the run's vehicle model
+(:attr:`tmem.model.base.VehicleModel.state_names`, at its ``POSITION`` and
+``VELOCITY`` indices), built from the scenario the file carries.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..readback import columns, evenly, quiet_unraisable, reason
+
+#: Most agents shown; larger runs are thinned evenly to this many.
+MAX_AGENTS = 1000
+#: Most recorded times shown (frames), when no ``max_frames`` is given.
+MAX_FRAMES = 1000
+#: Most coordinates (frames x agents x axes) stored when no ``max_frames`` is given: the
+#: frames of large swarms are thinned further, so that the page stays a few megabytes.
+MAX_COORDINATES = 600_000
+#: Most formation edges drawn (between agents shown); more are thinned evenly.
+MAX_EDGES = 3000
+#: Most pairs drawn one line each in the distance panel; more are drawn as their
+#: smallest, median and largest distance.
+MAX_PAIR_LINES = 60
+#: Codes of an agent's state in :attr:`View.status`.
+WAITING, FLYING, REMOVED = 0, 1, 2
+
+
+class NotARun(ValueError):
+    """A directory that is not a readable run; the message is one line."""
+
+
+@dataclass
+class View:
+    """What the page shows: a run's kept agents at its kept times.
+
+    Attributes
+    ----------
+    name : str
+        The scenario's name.
+    axis_names : list of str
+        ``x``, ``y``, ``z``: one per axis of the run (1 to 3).
+    radius : float
+        ``R`` (m), the radius of each agent's interaction sphere.
+    reach : float
+        ``R + R_j`` (m): agents interact closer than this.
+    space : dict
+        ``box`` (sides, m, or None), ``periodic``, ``walls`` and ``obstacles``
+        (``center``, ``radius``) of the scenario's space.
+    agents : ndarray of int, shape (A,)
+        The kept agents, numbered from 1 as in the paper (the scenario's index + 1).
+    time : ndarray, shape (F,)
+        The kept recorded times (s).
+    position : ndarray, shape (F, A, axes)
+        Positions (m); a removed agent's is where it last flew.
+    speed : ndarray, shape (F, A)
+        Speeds ``|V|`` (m/s).
+    status : ndarray of uint8, shape (F, A)
+        :data:`WAITING` (not yet added), :data:`FLYING` or :data:`REMOVED`.
+    edges : ndarray of int, shape (E, 2)
+        Formation edges between kept agents, as columns of ``position``.
+    strain : ndarray, shape (F, E)
+        ``(|P_j - P_i| - d_t) / d_t`` of each edge.
+    coupled : ndarray of bool, shape (F, E)
+        ``F_en = 1``.
+    strain_scale : float
+        The end of the symmetric colour scale of strain, fitted to the run (:func:`strain_scale`).
+    rms : ndarray, shape (F,)
+        The RMS velocity of the recorded agents flying (m/s).
+    pair_labels : list of str
+        The name of each series of ``pair_distance``.
+    pair_distance : ndarray, shape (F, S)
+        Each pair's distance ``|P_j - P_i|`` (m), or the smallest, median and largest over the pairs.
+    d_t : list of float
+        The pairs' set distances (m), at most three of them, as reference lines.
+    headline : list of (str, str)
+        Figures of ``summary.json`` shown above the view.
+    note : str
+        What is shown of the run, when it was thinned; empty when everything is.
+    """
+
+    name: str
+    axis_names: list[str]
+    radius: float
+    reach: float
+    space: dict
+    agents: np.ndarray
+    time: np.ndarray
+    position: np.ndarray
+    speed: np.ndarray
+    status: np.ndarray
+    edges: np.ndarray
+    strain: np.ndarray
+    coupled: np.ndarray
+    strain_scale: float
+    rms: np.ndarray
+    pair_labels: list[str]
+    pair_distance: np.ndarray
+    d_t: list[float]
+    headline: list[tuple[str, str]] = field(default_factory=list)
+    note: str = ""
+
+
+def run_files(run_dir: Path) -> tuple[Path, Path]:
+    """``run_dir``'s ``trajectory.nc`` and ``summary.json``; refuse, in one line, a directory that is not a run.
+
+    Parameters
+    ----------
+    run_dir : Path
+        A directory written by ``tmem run``.
+    """
+    if not run_dir.exists():
+        raise NotARun(f"{run_dir}: no such directory")
+    if not run_dir.is_dir():
+        raise NotARun(f"{run_dir}: is a file, not a run directory; give the directory tmem run wrote")
+    missing = [name for name in ("trajectory.nc", "summary.json") if not (run_dir / name).is_file()]
+    if missing:
+        raise NotARun(f"{run_dir}: is not a run directory (no {' and no '.join(missing)}); give one written by tmem run")
+    return run_dir / "trajectory.nc", run_dir / "summary.json"
+
+
+def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int | None = None) -> View:
+    """Read what the page shows of the run in ``run_dir``.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        A directory written by ``tmem run``.
+    max_agents : int
+        Most agents shown; more are thinned evenly (:func:`tmem.readback.evenly`).
+    max_frames : int, optional
+        Most recorded times shown.  Default: :data:`MAX_FRAMES`, fewer if the
+        frames would hold more than :data:`MAX_COORDINATES` coordinates.
+
+    Raises
+    ------
+    NotARun
+        One line: no such directory, no ``trajectory.nc`` or ``summary.json``
+        in it, or a file that cannot be read as a run's (damaged, truncated,
+        without its scenario).
+    """
+    trajectory, summary = run_files(Path(run_dir))
+    try:
+        headline = _headline(json.loads(summary.read_text(encoding="utf-8")))
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError) as exc:
+        raise NotARun(f"{summary}: cannot be read as a run's summary ({reason(exc)})") from None
+    message = None
+    with quiet_unraisable():
+        try:
+            view = _read(trajectory, max_agents, max_frames)
+        except NotARun:
+            raise
+        except Exception as exc:  # noqa: BLE001 - a damaged file fails in h5py, h5netcdf or NumPy, each its own way
+            message = f"{trajectory}: cannot be read as a run's trajectory ({reason(exc)})"
+    if message is not None:
+        raise NotARun(message)  # outside the handler: the failed file is freed, quietly, before this
+    view.headline = headline
+    return view
+
+
+def _scenario_and_model(text, path: Path):
+    """The run's scenario (from the file's ``scenario`` attribute) and its vehicle model."""
+    from ..model import vehicle_model
+    from ..scenario import ScenarioError, loads
+
+    if not isinstance(text, str):
+        raise NotARun(f"{path}: carries no scenario; give a run written by tmem run")
+    try:
+        scenario = loads(text, source="its scenario")
+    except ScenarioError as exc:
+        raise NotARun(f"{path}: {exc}") from None
+    return scenario, vehicle_model(scenario.model)
+
+
+def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
+    import h5netcdf
+
+    with h5netcdf.File(path, "r") as f:
+        scenario, model = _scenario_and_model(f.attrs.get("scenario"), path)
+        variables = f.variables
+        n_times, n_agents, n_axes = variables[model.state_names[model.POSITION]].shape
+        if n_times == 0 or n_agents == 0:
+            raise NotARun(f"{path}: the run recorded no times or no agents")
+        agents = evenly(n_agents, max_agents)
+        if max_frames is None:
+            max_frames = min(MAX_FRAMES, max(2, MAX_COORDINATES // (len(agents) * n_axes)))
+        frames = evenly(n_times, max_frames)
+
+        def at_frames(name: str) -> np.ndarray:
+            values = variables[name]
+            if 0 in values.shape:  # no pairs: HDF5 selects nothing from an empty dataset
+                return np.zeros((len(frames), *values.shape[1:]), values.dtype)
+            return np.asarray(values[frames] if len(frames) < n_times else values[...])
+
+        position = at_frames(model.state_names[model.POSITION])[:, agents].astype(float)
+        speed = np.linalg.norm(at_frames(model.state_names[model.VELOCITY])[:, agents], axis=-1)
+        active = at_frames("active")[:, agents].astype(bool)
+        status, position = _status(active, position)
+        ids = np.asarray(variables["agent"][...])
+        pairs = np.stack([variables["pair_i"][...], variables["pair_j"][...]], axis=1).astype(int).reshape(-1, 2)
+        distance = at_frames("distance").reshape(len(frames), len(pairs)).astype(float)
+        d_t = np.asarray(variables["d_t"][...], dtype=float)
+        edges, edge_pairs = _edges(ids[agents], pairs)
+        strain = distance[:, edge_pairs] / d_t[edge_pairs] - 1.0
+        coupled = at_frames("F_en").reshape(len(frames), len(pairs))[:, edge_pairs] == 1
+        pair_labels, pair_distance = _pair_series(distance, pairs)
+        view = View(
+            name=scenario.name,
+            axis_names=["x", "y", "z"][:n_axes],
+            radius=scenario.interaction.radius,
+            reach=scenario.interaction.reach,
+            space=_space(scenario),
+            agents=ids[agents] + 1,
+            time=np.asarray(variables["time"][frames], dtype=float),
+            position=position,
+            speed=speed,
+            status=status,
+            edges=edges,
+            strain=strain,
+            coupled=coupled,
+            strain_scale=strain_scale(strain, coupled, status, edges),
+            rms=at_frames("rms_velocity").astype(float),
+            pair_labels=pair_labels,
+            pair_distance=pair_distance,
+            d_t=[float(v) for v in np.unique(d_t)[:3]],
+        )
+    view.note = thinning_note(len(agents), n_agents, len(frames), n_times, len(edges), len(_edges_between(ids[agents], pairs)))
+    return view
+
+
+def _status(active: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each agent's state code at each frame, and the positions with each removed agent held where it last flew."""
+    frame = np.arange(len(active))[:, None]
+    last = np.maximum.accumulate(np.where(active, frame, -1), axis=0)
+    status = np.where(active, FLYING, np.where(last >= 0, REMOVED, WAITING)).astype(np.uint8)
+    held = position[np.maximum(last, 0), np.arange(active.shape[1])]
+    return status, np.where((status == REMOVED)[..., None], held, position)
+
+
+def _edges_between(kept: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """The pairs (indices into ``pairs``) whose two agents are both kept."""
+    _, found_i = columns(kept, pairs[:, 0])
+    _, found_j = columns(kept, pairs[:, 1])
+    return np.flatnonzero(found_i & found_j)
+
+
+def _edges(kept: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Formation edges between kept agents (as their columns), at most :data:`MAX_EDGES`, and their pairs."""
+    between = _edges_between(kept, pairs)
+    drawn = between[evenly(len(between), MAX_EDGES)]
+    col_i, _ = columns(kept, pairs[drawn, 0])
+    col_j, _ = columns(kept, pairs[drawn, 1])
+    return np.stack([col_i, col_j], axis=1).reshape(-1, 2), drawn
+
+
+def strain_scale(strain: np.ndarray, coupled: np.ndarray, status: np.ndarray, edges: np.ndarray) -> float:
+    """The end of the symmetric colour scale of edge strain, fitted to the run.
+
+    The 99th percentile of ``|strain|`` over the coupled edges between flying
+    agents at every frame shown (over every edge between flying agents if none
+    is coupled), so that a formation holding ``d_t`` within 1 % uses the whole
+    scale; at least 0.1 %.
+
+    Parameters
+    ----------
+    strain : ndarray, shape (F, E)
+        ``(|d| - d_t) / d_t`` of each edge at each frame.
+    coupled : ndarray of bool, shape (F, E)
+        ``F_en = 1``.
+    status : ndarray of uint8, shape (F, A)
+        Each agent's state code.
+    edges : ndarray of int, shape (E, 2)
+        Each edge's agents, as columns of ``status``.
+    """
+    flying = (status[:, edges[:, 0]] == FLYING) & (status[:, edges[:, 1]] == FLYING)
+    chosen = flying & coupled if (flying & coupled).any() else flying
+    values = np.abs(strain[chosen & np.isfinite(strain)])
+    return max(float(np.percentile(values, 99)) if values.size else 0.0, 1e-3)
+
+
+def _pair_series(distance: np.ndarray, pairs: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """The distance panel's series: each pair (agents numbered from 1), or the smallest, median and largest."""
+    if len(pairs) <= MAX_PAIR_LINES:
+        return [f"agents {i + 1}–{j + 1}" for i, j in pairs], distance
+    envelope = np.stack([distance.min(axis=1), np.median(distance, axis=1), distance.max(axis=1)], axis=1)
+    return [f"smallest of {len(pairs)} pairs", "median", "largest"], envelope
+
+
+def _space(scenario) -> dict:
+    space = scenario.space
+    obstacles = [{"center": list(o.center), "radius": o.radius} for o in scenario.obstacles]
+    return {"box": space.box, "periodic": space.periodic, "walls": space.walls, "obstacles": obstacles}
+
+
+def thinning_note(agents: int, agents_recorded: int, frames: int, times_recorded: int, edges: int, edges_between: int) -> str:
+    """The page's note on what is shown of a thinned run; empty when everything is.
+
+    Parameters
+    ----------
+    agents, agents_recorded : int
+        Agents shown, of those the run recorded.
+    frames, times_recorded : int
+        Recorded times shown, of those the run recorded.
+    edges, edges_between : int
+        Formation edges drawn, of those between the agents shown.
+    """
+    parts = []
+    if agents < agents_recorded:
+        parts.append(f"{agents} of {agents_recorded} agents, evenly chosen by number")
+    if frames < times_recorded:
+        parts.append(f"{frames} of {times_recorded} recorded times, evenly spaced")
+    if edges < edges_between:
+        parts.append(f"{edges} of the {edges_between} formation edges between them")
+    return "Shown: " + "; ".join(parts) + "." if parts else ""
+
+
+def _number(value, form: str, unit: str = "") -> str:
+    return "—" if not isinstance(value, (int, float)) or isinstance(value, bool) else form.format(value) + unit
+
+
+def _headline(summary: dict) -> list[tuple[str, str]]:
+    """The figures of ``summary.json`` shown above the view."""
+    pairs = summary.get("pairs")
+    rows = [
+        ("agents", _number(summary.get("agents"), "{:d}")),
+        ("function", str(summary.get("function", "—"))),
+        ("duration", _number(summary.get("duration"), "{:g}", " s")),
+        ("ΔRMS", _number(summary.get("rms_change_percent"), "{:+.3f}", " %")),
+        ("min distance", _number(summary.get("min_distance"), "{:.2f}", " m")),
+    ]
+    if isinstance(pairs, list) and pairs:
+        rows.append(("pairs coupled at end", f"{_number(summary.get('pairs_coupled_at_end'), '{:d}')}/{len(pairs)}"))
+    return rows
