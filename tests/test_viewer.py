@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 from tmem.cli import app
 from tmem.model.linear import LinearModel
 from tmem.viewer import default_out, write_view
-from tmem.viewer.data import MAX_COORDINATES, REMOVED, WAITING, NotARun, read_view, strain_scale
+from tmem.viewer.data import FLYING, MAX_COORDINATES, REMOVED, WAITING, NotARun, agent_status, read_view, strain_scale
 from tmem.viewer.page import VIEW_MARK, quantised
 
 VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
@@ -44,7 +44,7 @@ def write_run(directory: Path, n_agents=3, n_times=30, n_axes=2, pairs=((0, 1), 
     active = np.ones((n_times, n_agents), np.int8)
     if removed:
         active[2 * n_times // 3 :, n_agents - 1] = 0
-        position[2 * n_times // 3 :, n_agents - 1] = 1e6  # wherever the file says, the page holds it where it stopped
+        position[2 * n_times // 3 :, n_agents - 1] = position[2 * n_times // 3 - 1, n_agents - 1]  # stopped, as the engine holds it
     over = ("time", "agent", "axis")
     zeros = np.zeros_like(position)
     data = {names[0]: (over, position), names[1]: (over, np.broadcast_to(velocity, position.shape)),
@@ -126,13 +126,16 @@ def test_strain_scale_is_the_99th_percentile_of_the_coupled_edges():
     assert strain_scale(np.zeros_like(strain), coupled, status, edges) == 1e-3  # a rigid formation: the smallest scale
 
 
-def test_a_removed_agent_is_held_where_it_stopped(tmp_path):
+def test_agents_are_waiting_flying_or_removed(tmp_path):
     run = write_run(tmp_path / "run", n_agents=3, n_times=30)
     view = read_view(run)
     gone = 20  # 2 * 30 // 3
-    assert (view.status[:gone, 2] == 1).all() and (view.status[gone:, 2] == REMOVED).all()
-    np.testing.assert_array_equal(view.position[gone:, 2], np.broadcast_to(view.position[gone - 1, 2], (10, 2)))
-    assert WAITING not in view.status
+    assert (view.status[:gone] == FLYING).all() and (view.status[gone:, :2] == FLYING).all()
+    assert (view.status[gone:, 2] == REMOVED).all()
+    later = np.ones((5, 3), bool)
+    later[:2, 1] = False  # added at the third frame
+    later[3, 1] = False  # removed, then added back
+    assert agent_status(later)[:, 1].tolist() == [WAITING, WAITING, FLYING, REMOVED, FLYING]
 
 
 def test_large_swarms_are_thinned_and_the_page_says_so(tmp_path):

@@ -64,7 +64,7 @@ class View:
     time : ndarray, shape (F,)
         The kept recorded times (s).
     position : ndarray, shape (F, A, axes)
-        Positions (m); a removed agent's is where it last flew.
+        Positions (m); a removed agent stays where it stopped (the engine holds it there).
     speed : ndarray, shape (F, A)
         Speeds ``|V|`` (m/s).
     status : ndarray of uint8, shape (F, A)
@@ -207,7 +207,7 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
         position = at_frames(model.state_names[model.POSITION])[:, agents].astype(float)
         speed = np.linalg.norm(at_frames(model.state_names[model.VELOCITY])[:, agents], axis=-1)
         active = at_frames("active")[:, agents].astype(bool)
-        status, position = _status(active, position)
+        status = agent_status(active)
         ids = np.asarray(variables["agent"][...])
         pairs = np.stack([variables["pair_i"][...], variables["pair_j"][...]], axis=1).astype(int).reshape(-1, 2)
         distance = at_frames("distance").reshape(len(frames), len(pairs)).astype(float)
@@ -240,13 +240,17 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
     return view
 
 
-def _status(active: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each agent's state code at each frame, and the positions with each removed agent held where it last flew."""
-    frame = np.arange(len(active))[:, None]
-    last = np.maximum.accumulate(np.where(active, frame, -1), axis=0)
-    status = np.where(active, FLYING, np.where(last >= 0, REMOVED, WAITING)).astype(np.uint8)
-    held = position[np.maximum(last, 0), np.arange(active.shape[1])]
-    return status, np.where((status == REMOVED)[..., None], held, position)
+def agent_status(active: np.ndarray) -> np.ndarray:
+    """Each agent's state code at each frame: :data:`FLYING`, :data:`REMOVED` (not flying after it
+    flew) or :data:`WAITING` (not yet added).
+
+    Parameters
+    ----------
+    active : ndarray of bool, shape (F, A)
+        Whether each agent flies at each frame (the file's ``active``).
+    """
+    flown = np.maximum.accumulate(active, axis=0)
+    return np.where(active, FLYING, np.where(flown, REMOVED, WAITING)).astype(np.uint8)
 
 
 def _edges_between(kept: np.ndarray, pairs: np.ndarray) -> np.ndarray:

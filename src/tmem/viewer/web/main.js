@@ -29,6 +29,7 @@ function fillLegend() {
   const gradient = `linear-gradient(to right, ${COLOURS.closer}, ${COLOURS.atSet}, ${COLOURS.farther})`;
   $('legend-agent').style.background = COLOURS.agent;
   $('legend-removed').style.color = COLOURS.removed;
+  $('legend-removed').parentElement.hidden = !run.status.includes(REMOVED);
   $('legend-strain').hidden = run.E === 0;
   $('strain-bar').style.background = gradient;
   $('strain-low').textContent = `−${pct(run.strainScale)}`;

@@ -56,12 +56,47 @@ function points(count, size, texture, colour) {
   return new THREE.Points(geometry, material);
 }
 
-function segments(count, opacity) {
-  const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * count), 3));
-  geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(6 * count), 3));
-  const material = new THREE.LineBasicMaterial({ vertexColors: true, transparent: opacity < 1, opacity });
-  return new THREE.LineSegments(geometry, material);
+// Edges as quads a few pixels wide whatever the zoom (WebGL draws lines 1 px wide): each edge is an
+// instance of a unit quad whose ends are moved to the edge's ends on screen and widened there.
+const EDGE_VERTEX = `
+uniform vec2 resolution;
+uniform float width;
+attribute vec3 instanceStart;
+attribute vec3 instanceEnd;
+attribute vec3 instanceColour;
+varying vec3 vColour;
+void main() {
+  vColour = instanceColour;
+  vec4 a = projectionMatrix * modelViewMatrix * vec4(instanceStart, 1.0);
+  vec4 b = projectionMatrix * modelViewMatrix * vec4(instanceEnd, 1.0);
+  vec2 along = normalize((b.xy / b.w - a.xy / a.w) * resolution);
+  vec4 end = position.x < 0.5 ? a : b;
+  end.xy += vec2(-along.y, along.x) * position.y * width / resolution * end.w;
+  gl_Position = end;
+}`;
+const EDGE_FRAGMENT = `
+uniform float opacity;
+varying vec3 vColour;
+void main() {
+  gl_FragColor = vec4(vColour, opacity);
+  #include <colorspace_fragment>
+}`;
+
+function edgeQuads(count, opacity) {
+  const geometry = new THREE.InstancedBufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute([0, -1, 0, 1, -1, 0, 0, 1, 0, 1, 1, 0], 3));
+  geometry.setIndex([0, 1, 2, 2, 1, 3]);
+  for (const name of ['instanceStart', 'instanceEnd', 'instanceColour']) {
+    geometry.setAttribute(name, new THREE.InstancedBufferAttribute(new Float32Array(3 * Math.max(count, 1)), 3));
+  }
+  geometry.instanceCount = 0;
+  const material = new THREE.ShaderMaterial({
+    vertexShader: EDGE_VERTEX, fragmentShader: EDGE_FRAGMENT, transparent: opacity < 1, depthWrite: opacity === 1,
+    uniforms: { resolution: { value: new THREE.Vector2(1, 1) }, width: { value: 2.5 }, opacity: { value: opacity } },
+  });
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.frustumCulled = false;
+  return mesh;
 }
 
 function lines(vertices, colour) {
@@ -182,15 +217,14 @@ export class Scene {
     this.agents = points(A, size, DOT(), COLOURS.agent);
     this.agents.renderOrder = 3;
     this.removed = points(A, size + 2, CROSS(), COLOURS.removed);
-    this.coupledEdges = segments(E, 1);
-    this.looseEdges = segments(E, 0.3);
+    this.coupledEdges = edgeQuads(E, 1);
+    this.looseEdges = edgeQuads(E, 0.35);
     const material = D === 3
       ? new THREE.MeshLambertMaterial({ color: COLOURS.sphere, transparent: true, opacity: 0.12, depthWrite: false })
       : new THREE.MeshBasicMaterial({ color: COLOURS.sphere, transparent: true, opacity: 0.1, depthWrite: false });
     this.spheres = new THREE.InstancedMesh(this.sphereGeometry, material, A);
     this.spheres.visible = false;
     this.spheres.frustumCulled = this.agents.frustumCulled = this.removed.frustumCulled = false;
-    this.coupledEdges.frustumCulled = this.looseEdges.frustumCulled = false;
     this.scene.add(this.spheres, this.looseEdges, this.coupledEdges, this.removed, this.agents);
     this.shown = new Int32Array(A); // the agent column of each drawn point, flying then removed
   }
@@ -263,16 +297,15 @@ export class Scene {
       if (half && (Math.abs(p.x - q.x) > half.x || Math.abs(p.y - q.y) > half.y || Math.abs(p.z - q.z) > half.z)) continue;
       const which = coupled[f * E + e] ? 0 : 1;
       const k = counts[which]++;
-      const { position, color } = objects[which].geometry.attributes;
-      position.setXYZ(2 * k, p.x, p.y, p.z - below);
-      position.setXYZ(2 * k + 1, q.x, q.y, q.z - below);
+      const { instanceStart, instanceEnd, instanceColour } = objects[which].geometry.attributes;
+      instanceStart.setXYZ(k, p.x, p.y, p.z - below);
+      instanceEnd.setXYZ(k, q.x, q.y, q.z - below);
       const c = strainColour(strain[f * E + e], strainScale);
-      color.setXYZ(2 * k, c.r, c.g, c.b);
-      color.setXYZ(2 * k + 1, c.r, c.g, c.b);
+      instanceColour.setXYZ(k, c.r, c.g, c.b);
     }
     objects.forEach((o, w) => {
-      o.geometry.setDrawRange(0, 2 * counts[w]);
-      o.geometry.attributes.position.needsUpdate = o.geometry.attributes.color.needsUpdate = true;
+      o.geometry.instanceCount = counts[w];
+      for (const name of ['instanceStart', 'instanceEnd', 'instanceColour']) o.geometry.attributes[name].needsUpdate = true;
     });
   }
 
@@ -302,6 +335,11 @@ export class Scene {
     const { clientWidth: w, clientHeight: h } = this.container;
     if (!w || !h) return;
     this.renderer.setSize(w, h);
+    const pixels = this.renderer.getDrawingBufferSize(new THREE.Vector2());
+    for (const edges of [this.coupledEdges, this.looseEdges]) {
+      edges.material.uniforms.resolution.value.copy(pixels);
+      edges.material.uniforms.width.value = 2.5 * this.renderer.getPixelRatio();
+    }
     if (this.run.D === 3) {
       this.camera.aspect = w / h;
     } else {
