@@ -25,11 +25,12 @@ from tmem.viewer.page import VIEW_MARK, quantised
 VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
 
 
-def scenario_text(n_agents: int, n_axes: int) -> str:
-    return f'name = "synthetic"\n[space]\naxes = {n_axes}\n[interaction]\nfunction = "repulsion"\nd_t = 35.0\n[swarm]\nn = {n_agents}\nregion = {[200.0] * n_axes}\n'
+def scenario_text(n_agents: int, n_axes: int, name: str = "synthetic") -> str:
+    return f'name = {json.dumps(name)}\n[space]\naxes = {n_axes}\n[interaction]\nfunction = "repulsion"\nd_t = 35.0\n[swarm]\nn = {n_agents}\nregion = {[200.0] * n_axes}\n'
 
 
-def write_run(directory: Path, n_agents=3, n_times=30, n_axes=2, pairs=((0, 1), (1, 2)), removed=True, names=("P", "V", "phi", "omega")):
+def write_run(directory: Path, n_agents=3, n_times=30, n_axes=2, pairs=((0, 1), (1, 2)), removed=True,
+              names=("P", "V", "phi", "omega"), name="synthetic"):  # fmt: skip
     """A run directory: agents on straight lines, pairs coupling halfway, the last agent removed at two thirds."""
     directory.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(1)
@@ -59,7 +60,7 @@ def write_run(directory: Path, n_agents=3, n_times=30, n_axes=2, pairs=((0, 1), 
     }
     coords = {"time": time, "agent": np.arange(n_agents), "axis": ["x", "y", "z"][:n_axes], "pair": np.arange(len(pairs)),
               "pair_i": ("pair", pairs[:, 0]), "pair_j": ("pair", pairs[:, 1])}  # fmt: skip
-    xr.Dataset(data, coords=coords, attrs={"scenario": scenario_text(n_agents, n_axes)}).to_netcdf(
+    xr.Dataset(data, coords=coords, attrs={"scenario": scenario_text(n_agents, n_axes, name)}).to_netcdf(
         directory / "trajectory.nc", engine="h5netcdf"
     )
     summary = {"scenario": "synthetic", "function": "improved", "agents": n_agents, "duration": float(time[-1]),
@@ -222,6 +223,14 @@ def test_the_page_fetches_nothing(tmp_path):
     imports = json.loads(re.search(r'<script type="importmap">(.*?)</script>', page, re.S).group(1))["imports"]
     assert imports and all(url.startswith("data:text/javascript;base64,") for url in imports.values())
     assert page.count("</script>") == page.count("<script")  # nothing inlined closes a script early
+
+
+def test_a_name_with_markup_is_shown_as_written(tmp_path):
+    name = '</script><b>x</b> & "q" <!-- 日本語'
+    page = write_view(write_run(tmp_path / "run", name=name), tmp_path / "view.html")
+    assert embedded(page)["name"] == name
+    text = page.read_text()
+    assert "<b>x</b>" not in text and "<title>&lt;/script&gt;&lt;b&gt;x&lt;/b&gt; &amp; &quot;q&quot; &lt;!-- 日本語: tmem view</title>" in text
 
 
 def test_the_shipped_libraries_are_the_ones_the_docs_name():

@@ -6,6 +6,7 @@ import { WebGLRenderer } from 'three';
 import { COLOURS, niceStep, Scene } from 'tmem/scene';
 
 const $ = (id) => document.getElementById(id);
+const timing = { scripts: performance.now() }; // ms from the start of navigation
 const run = decode($('tmem-run').textContent);
 // Playback speeds, in simulated seconds per second.
 const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 5, 10, 20, 50, 100];
@@ -136,9 +137,11 @@ function scaleBar(scene) {
 }
 
 const scene = makeScene();
+timing.view = performance.now();
 fillHeader();
 fillLegend();
 const charts = new Charts($('chart-rms'), $('chart-pairs'), run, (t) => player.seek(t));
+timing.panels = performance.now();
 const player = new Player(scene, charts);
 wireToggles(scene);
 if (scene) {
@@ -164,6 +167,7 @@ window.tmemViewer = {
   screen() { return scene ? Array.from(scene.shown.subarray(0, scene.shownCount), (a) => scene.screen(a).slice(0, 2)) : []; },
   spheresShown() { return Boolean(scene?.spheres.visible && scene.spheres.count); },
   cursors() { return charts.cursorPositions(); },
+  timing,
   readyMs: performance.now(),
 };
 document.body.dataset.ready = 'true';
