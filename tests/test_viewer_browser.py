@@ -26,6 +26,7 @@ import tmem
 from tmem.io import write_run
 from tmem.scenario import load
 from tmem.viewer import write_view
+from tmem.viewer.data import read_view
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = Path(os.environ.get("TMEM_CHROMIUM", "/usr/bin/chromium"))
@@ -141,6 +142,16 @@ def pixels_near(image: np.ndarray, colour, tolerance=10) -> int:
     return int((np.abs(image - np.array(colour)).max(axis=-1) <= tolerance).sum())
 
 
+def strain_colour(strain: float, scale: float) -> np.ndarray:
+    """The colour the docs give an edge of this strain: dark grey at d_t towards purple (closer) or
+    orange (farther), mixed in linear light, as sRGB 0-255."""
+    linear = lambda c: np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)  # noqa: E731
+    srgb = lambda v: np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)  # noqa: E731
+    at_set, end = np.array([0x40] * 3) / 255, np.array([0x7B, 0x32, 0x94] if strain < 0 else [0xE6, 0x61, 0x01]) / 255
+    s = min(abs(strain) / scale, 1.0)
+    return 255 * srgb((1 - s) * linear(at_set) + s * linear(end))
+
+
 def light_blue(image: np.ndarray) -> int:
     """Pixels of an interaction sphere's translucent fill over white."""
     r, g, b = image[..., 0], image[..., 1], image[..., 2]
@@ -167,13 +178,21 @@ def test_the_hex_plays_and_shows_what_the_file_holds(open_view, runs, tmp_path):
     assert all(after > before + 200 for before, after in zip(cursors, viewer.js("tmemViewer.cursors()")))
 
 
-def test_the_hex_screenshot_shows_agents_and_the_spheres_on_demand(open_view, runs, tmp_path):
-    viewer = open_view(write_view(runs("hex19"), tmp_path / "hex19.html"))
+def test_the_hex_screenshot_shows_agents_edges_by_strain_and_spheres_on_demand(open_view, runs, tmp_path):
+    run = runs("hex19")
+    viewer = open_view(write_view(run, tmp_path / "hex19.html"))
     viewer.page.focus("#time")
     for _ in range(3):
         viewer.page.keyboard.press("PageUp")  # a few steps into the run
     plain = viewer.screenshot(tmp_path / "plain.png")
     assert not viewer.js("tmemViewer.spheresShown()")
+    view, f = read_view(run), viewer.js("tmemViewer.player.frame")
+    screen, box = viewer.screen(), viewer.page.locator("#view canvas").bounding_box()
+    for e in (np.argmax(view.strain[f]), np.argmin(view.strain[f]), np.argmin(np.abs(view.strain[f]))):
+        x, y = screen[view.edges[e]].mean(axis=0) + [box["x"], box["y"]]  # the edge's midpoint in the page
+        near = plain[int(y) - 1 : int(y) + 2, int(x) - 1 : int(x) + 2].reshape(-1, 3)
+        drawn = near[np.argmin(near.sum(axis=1))]  # the pixel least blended with the white behind it
+        assert np.abs(drawn - strain_colour(view.strain[f, e], view.strain_scale)).max() < 30, (e, drawn)
     viewer.page.click("#show-spheres")
     assert viewer.js("tmemViewer.spheresShown()")
     docs = ROOT / "docs" / "images" / "viewer-hex19.png"

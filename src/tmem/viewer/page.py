@@ -29,6 +29,7 @@ MODULES = {
     "three": ("vendor", "three.module.min.js"),
     "three/addons/OrbitControls": ("vendor", "OrbitControls.js"),
     "tmem/run": ("web", "run.js"),
+    "tmem/edges": ("web", "edges.js"),
     "tmem/scene": ("web", "scene.js"),
     "tmem/charts": ("web", "charts.js"),
     "tmem/main": ("web", "main.js"),

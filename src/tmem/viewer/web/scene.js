@@ -3,28 +3,17 @@
 // (1-D, 2-D) and zoom; agent numbers and the agent under the pointer.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls';
+import { edgeQuads, STRAIN_COLOURS, strainColour } from 'tmem/edges';
 import { FLYING, REMOVED, WAITING } from 'tmem/run';
 
 export const COLOURS = {
-  agent: '#1f77b4', removed: '#7f7f7f', sphere: '#1f77b4', frame: '#b8b8b8', box: '#555555',
-  obstacle: '#999999', closer: '#7b3294', atSet: '#404040', farther: '#e66101',
+  agent: '#1f77b4', removed: '#7f7f7f', sphere: '#1f77b4', frame: '#b8b8b8', box: '#555555', obstacle: '#999999',
+  ...STRAIN_COLOURS,
 };
 // Most agents labelled with their numbers.
 const MAX_LABELS = 60;
 // How near the pointer (px) an agent must be to be named.
 const PICK_PX = 12;
-
-function srgb(hex) {
-  const c = new THREE.Color(hex);
-  return [c.r, c.g, c.b]; // linear: three converts CSS colours from sRGB
-}
-
-// The colour of a strain on the symmetric scale [-scale, scale]: closer, at d_t, farther.
-export function strainColour(strain, scale) {
-  const s = Math.max(-1, Math.min(1, strain / scale));
-  const [from, to] = s < 0 ? [COLOURS.atSet, COLOURS.closer] : [COLOURS.atSet, COLOURS.farther];
-  return new THREE.Color(from).lerp(new THREE.Color(to), Math.abs(s)); // lerp in linear light
-}
 
 function sprite(draw) {
   const canvas = document.createElement('canvas');
@@ -54,49 +43,6 @@ function points(count, size, texture, colour) {
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * count), 3));
   const material = new THREE.PointsMaterial({ size, sizeAttenuation: false, map: texture, alphaTest: 0.5, color: colour });
   return new THREE.Points(geometry, material);
-}
-
-// Edges as quads a few pixels wide whatever the zoom (WebGL draws lines 1 px wide): each edge is an
-// instance of a unit quad whose ends are moved to the edge's ends on screen and widened there.
-const EDGE_VERTEX = `
-uniform vec2 resolution;
-uniform float width;
-attribute vec3 instanceStart;
-attribute vec3 instanceEnd;
-attribute vec3 instanceColour;
-varying vec3 vColour;
-void main() {
-  vColour = instanceColour;
-  vec4 a = projectionMatrix * modelViewMatrix * vec4(instanceStart, 1.0);
-  vec4 b = projectionMatrix * modelViewMatrix * vec4(instanceEnd, 1.0);
-  vec2 along = normalize((b.xy / b.w - a.xy / a.w) * resolution);
-  vec4 end = position.x < 0.5 ? a : b;
-  end.xy += vec2(-along.y, along.x) * position.y * width / resolution * end.w;
-  gl_Position = end;
-}`;
-const EDGE_FRAGMENT = `
-uniform float opacity;
-varying vec3 vColour;
-void main() {
-  gl_FragColor = vec4(vColour, opacity);
-  #include <colorspace_fragment>
-}`;
-
-function edgeQuads(count, opacity) {
-  const geometry = new THREE.InstancedBufferGeometry();
-  geometry.setAttribute('position', new THREE.Float32BufferAttribute([0, -1, 0, 1, -1, 0, 0, 1, 0, 1, 1, 0], 3));
-  geometry.setIndex([0, 1, 2, 2, 1, 3]);
-  for (const name of ['instanceStart', 'instanceEnd', 'instanceColour']) {
-    geometry.setAttribute(name, new THREE.InstancedBufferAttribute(new Float32Array(3 * Math.max(count, 1)), 3));
-  }
-  geometry.instanceCount = 0;
-  const material = new THREE.ShaderMaterial({
-    vertexShader: EDGE_VERTEX, fragmentShader: EDGE_FRAGMENT, transparent: opacity < 1, depthWrite: opacity === 1,
-    uniforms: { resolution: { value: new THREE.Vector2(1, 1) }, width: { value: 2.5 }, opacity: { value: opacity } },
-  });
-  const mesh = new THREE.Mesh(geometry, material);
-  mesh.frustumCulled = false;
-  return mesh;
 }
 
 function lines(vertices, colour) {
@@ -286,7 +232,7 @@ export class Scene {
     const { A, E, edges, status, strain, coupled, strainScale, space } = this.run;
     const objects = [this.coupledEdges, this.looseEdges];
     const counts = [0, 0];
-    const p = new THREE.Vector3(), q = new THREE.Vector3();
+    const p = new THREE.Vector3(), q = new THREE.Vector3(), colour = new THREE.Color();
     const half = space.periodic ? this.#point(space.box).multiplyScalar(0.5) : null;
     const below = this.run.D === 3 ? 0 : 0.1; // in the plane, edges under the agents
     for (let e = 0; e < E; e++) {
@@ -300,7 +246,7 @@ export class Scene {
       const { instanceStart, instanceEnd, instanceColour } = objects[which].geometry.attributes;
       instanceStart.setXYZ(k, p.x, p.y, p.z - below);
       instanceEnd.setXYZ(k, q.x, q.y, q.z - below);
-      const c = strainColour(strain[f * E + e], strainScale);
+      const c = strainColour(strain[f * E + e], strainScale, colour);
       instanceColour.setXYZ(k, c.r, c.g, c.b);
     }
     objects.forEach((o, w) => {
