@@ -14,7 +14,7 @@ navigation to the viewer's first frame drawn with its panels (``tmemViewer.ready
 
 Usage::
 
-    python benchmarks/bench_viewer.py [--repeat 3] [--json benchmarks/results/viewer.json]
+    python benchmarks/bench_viewer.py [--repeat 3] [--json benchmarks/results/viewer.json] [--keep DIR]
 """
 
 from __future__ import annotations
@@ -100,9 +100,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--json", type=Path, help="write the figures to this file")
+    parser.add_argument("--keep", type=Path, help="keep the runs and pages in this directory (default: a temporary one)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        results = measure(args.repeat, Path(tmp))
+        work = args.keep or Path(tmp)
+        work.mkdir(parents=True, exist_ok=True)
+        results = measure(args.repeat, work)
     results["machine"] = {"python": platform.python_version(), "processor": platform.processor() or platform.machine()}
     if args.json:
         args.json.write_text(json.dumps(results, indent=1) + "\n")

@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 from tmem.cli import app
 from tmem.model.linear import LinearModel
 from tmem.viewer import default_out, write_view
-from tmem.viewer.data import FLYING, MAX_COORDINATES, REMOVED, WAITING, NotARun, agent_status, read_view, strain_scale
+from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, NotARun, agent_status, read_view, strain_scale
 from tmem.viewer.page import VIEW_MARK, quantised
 
 VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
@@ -187,6 +187,11 @@ def test_what_is_not_a_run_is_refused_in_one_line_and_nothing_is_written(runner,
     assert "--max-frames: must be at least 1, got 0" in refused(runner, run, "--max-frames", "0")
     assert "--out" in refused(runner, run, "--out", run)  # a directory
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_the_help_gives_the_defaults_the_viewer_uses(runner):
+    text = " ".join(runner.invoke(app, ["view", "--help"], env={"COLUMNS": "200"}).output.split())
+    assert f"Default {MAX_AGENTS}." in text and f"Default {MAX_FRAMES}, fewer for large swarms." in text
 
 
 def test_an_existing_file_is_replaced_only_if_tmem_view_wrote_it(runner, tmp_path):
