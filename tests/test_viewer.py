@@ -20,6 +20,7 @@ from tmem.cli import app
 from tmem.model.linear import LinearModel
 from tmem.viewer import default_out, write_view
 from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, NotARun, agent_status, read_view, strain_scale
+from tmem.viewer import data
 from tmem.viewer.page import VIEW_MARK, quantised
 
 VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
@@ -148,6 +149,18 @@ def test_large_swarms_are_thinned_and_the_page_says_so(tmp_path):
     few = read_view(run, max_agents=10, max_frames=5)
     assert few.position.shape == (5, 10, 2)
     assert read_view(write_run(tmp_path / "small"), max_frames=None).note == ""
+
+
+def test_reading_a_block_of_frames_at_a_time_reads_the_same(tmp_path, monkeypatch):
+    run = write_run(tmp_path / "run", n_agents=7, n_times=50, pairs=((0, 1), (5, 6)))
+    whole = read_view(run, max_agents=5, max_frames=20)
+    monkeypatch.setattr(data, "_READ_VALUES", 9)  # a frame or so per block
+    blocks = read_view(run, max_agents=5, max_frames=20)
+    for name in ("time", "position", "speed", "status", "strain", "coupled", "rms", "pair_distance"):
+        np.testing.assert_array_equal(getattr(blocks, name), getattr(whole, name), err_msg=name)
+    every = read_view(run, max_frames=50)  # every frame: read in slices
+    monkeypatch.setattr(data, "_READ_VALUES", 10**9)
+    np.testing.assert_array_equal(every.position, read_view(run, max_frames=50).position)
 
 
 def test_state_names_come_from_the_vehicle_model(tmp_path, monkeypatch):

@@ -34,6 +34,8 @@ MAX_EDGES = 3000
 #: Most pairs drawn one line each in the distance panel; more are drawn as their
 #: smallest, median and largest distance.
 MAX_PAIR_LINES = 60
+#: Most values read from the file at once (a block of frames of a large swarm).
+_READ_VALUES = 20_000_000
 #: Codes of an agent's state in :attr:`View.status`.
 WAITING, FLYING, REMOVED = 0, 1, 2
 
@@ -184,7 +186,22 @@ def _scenario_and_model(text, path: Path):
     return scenario, vehicle_model(scenario.model)
 
 
+def _at_frames(values, frames: np.ndarray, columns: np.ndarray | None = None) -> np.ndarray:
+    """``values[frames][:, columns]`` of a variable over (time, ...), read a block of frames at a time
+    so that a large swarm's file is never in memory whole."""
+    if 0 in values.shape:  # no pairs: HDF5 selects nothing from an empty dataset
+        return np.zeros((len(frames), *values.shape[1:]), values.dtype)
+    every = len(frames) == values.shape[0]
+    step = max(1, _READ_VALUES // int(np.prod(values.shape[1:])))
+    blocks = []
+    for start in range(0, len(frames), step):
+        block = np.asarray(values[start : start + step] if every else values[frames[start : start + step]])
+        blocks.append(block if columns is None else block[:, columns])
+    return np.concatenate(blocks)
+
+
 def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
+    """The :class:`View` of ``path``, a ``trajectory.nc`` (without the headline)."""
     import h5netcdf
 
     with h5netcdf.File(path, "r") as f:
@@ -198,16 +215,12 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
             max_frames = min(MAX_FRAMES, max(2, MAX_COORDINATES // (len(agents) * n_axes)))
         frames = evenly(n_times, max_frames)
 
-        def at_frames(name: str) -> np.ndarray:
-            values = variables[name]
-            if 0 in values.shape:  # no pairs: HDF5 selects nothing from an empty dataset
-                return np.zeros((len(frames), *values.shape[1:]), values.dtype)
-            return np.asarray(values[frames] if len(frames) < n_times else values[...])
+        def at_frames(name: str, columns: np.ndarray | None = None) -> np.ndarray:
+            return _at_frames(variables[name], frames, columns)
 
-        position = at_frames(model.state_names[model.POSITION])[:, agents].astype(float)
-        speed = np.linalg.norm(at_frames(model.state_names[model.VELOCITY])[:, agents], axis=-1)
-        active = at_frames("active")[:, agents].astype(bool)
-        status = agent_status(active)
+        position = at_frames(model.state_names[model.POSITION], agents).astype(float)
+        speed = np.linalg.norm(at_frames(model.state_names[model.VELOCITY], agents), axis=-1)
+        status = agent_status(at_frames("active", agents).astype(bool))
         ids = np.asarray(variables["agent"][...])
         pairs = np.stack([variables["pair_i"][...], variables["pair_j"][...]], axis=1).astype(int).reshape(-1, 2)
         distance = at_frames("distance").reshape(len(frames), len(pairs)).astype(float)
@@ -223,7 +236,7 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
             reach=scenario.interaction.reach,
             space=_space(scenario),
             agents=ids[agents] + 1,
-            time=np.asarray(variables["time"][frames], dtype=float),
+            time=at_frames("time").astype(float),
             position=position,
             speed=speed,
             status=status,
