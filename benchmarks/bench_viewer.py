@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import statistics
 import tempfile
@@ -106,7 +107,13 @@ def main() -> None:
         work = args.keep or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         results = measure(args.repeat, work)
-    results["machine"] = {"python": platform.python_version(), "processor": platform.processor() or platform.machine()}
+    results["machine"] = {
+        "python": platform.python_version(),
+        "processor": platform.processor() or platform.machine(),
+        "cores": os.cpu_count(),
+        "load_average_1min_at_end": os.getloadavg()[0],  # other work on the machine slows the loads
+    }
+    print(f"load average at the end (1 min): {results['machine']['load_average_1min_at_end']:.1f} on {os.cpu_count()} cores")
     if args.json:
         args.json.write_text(json.dumps(results, indent=1) + "\n")
 
