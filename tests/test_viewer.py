@@ -9,6 +9,8 @@ import base64
 import hashlib
 import json
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -200,6 +202,17 @@ def test_what_is_not_a_run_is_refused_in_one_line_and_nothing_is_written(runner,
     assert "--max-frames: must be at least 1, got 0" in refused(runner, run, "--max-frames", "0")
     assert "--out" in refused(runner, run, "--out", run)  # a directory
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_view_help_loads_nothing_heavy():
+    probe = (
+        "import sys; sys.argv = ['tmem', 'view', '--help']\nfrom tmem.cli import main\n"
+        "try:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code\n"
+        "print('loaded:', *(m for m in ('numba', 'xarray', 'matplotlib', 'h5netcdf') if m in sys.modules))"
+    )
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.rpartition("loaded:")[2].split() == []
 
 
 def test_the_help_gives_the_defaults_the_viewer_uses(runner):

@@ -23,8 +23,12 @@ over it, so a 400-frame GIF of 20 agents takes a few seconds.
 
 from __future__ import annotations
 
+import gc
+import sys
 import tomllib
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,7 +45,6 @@ from PIL import Image
 from . import __version__
 from .outputs import ANIMATE_MARK, check_file, replace_file
 from .plot import draw_region
-from .readback import columns, evenly, quiet_unraisable, reason
 
 #: Most agents drawn; larger runs are thinned evenly to this many.
 MAX_AGENTS_DRAWN = 3000
@@ -51,6 +54,13 @@ MAX_CIRCLES = 2000
 MAX_DASHED_EDGES = 2000
 #: Strain ``|d| / d_t - 1`` at the ends of the colour scale of coupled edges.
 STRAIN_RANGE = 0.5
+
+
+def _evenly(n: int, at_most: int) -> np.ndarray:
+    """At most ``at_most`` indices into ``range(n)``, evenly spread, first and last kept."""
+    if n <= at_most:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, at_most)).astype(int))
 
 
 @dataclass
@@ -68,6 +78,13 @@ class _Run:
     name: str
     box: list | None  # the walled box's sides, None without walls
     obstacles: list  # (center, radius) of each obstacle
+
+
+def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where each of ``wanted`` is in ``ids``, and whether it is there at all."""
+    order = np.argsort(ids)
+    k = order[np.clip(np.searchsorted(ids, wanted, sorter=order), 0, len(ids) - 1)]
+    return k, ids[k] == wanted
 
 
 class _Refused(ValueError):
@@ -89,6 +106,25 @@ def _trajectory_path(run_dir: Path) -> Path:
     return run_dir / "trajectory.nc"
 
 
+@contextmanager
+def _quiet_unraisable() -> Iterator[None]:
+    """Silence errors raised while objects are freed (h5netcdf's half-opened file on a damaged one)."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = hook
+
+
+def _reason(exc: Exception) -> str:
+    """An exception as a short phrase of one line: its message, or its class when it has none."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    text = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
 def _load(run_dir: Path, max_frames: int) -> _Run:
     """Read the frames and agents to draw; a damaged or truncated ``trajectory.nc`` is refused in one line.
 
@@ -98,13 +134,13 @@ def _load(run_dir: Path, max_frames: int) -> _Run:
     """
     path = _trajectory_path(run_dir)
     message = None
-    with quiet_unraisable():
+    with _quiet_unraisable():
         try:
             return _read(path, max_frames)
         except _Refused:
             raise
         except Exception as exc:  # noqa: BLE001 - see the docstring
-            message = f"animate: {path}: cannot be read as a run's trajectory ({reason(exc)})"
+            message = f"animate: {path}: cannot be read as a run's trajectory ({_reason(exc)})"
     raise ValueError(message)  # outside the handler: the failed file is freed, quietly, before this
 
 
@@ -122,12 +158,12 @@ def _read(path: Path, max_frames: int) -> _Run:
             radius = float(scenario["interaction"]["radius"])
         except (KeyError, TypeError, ValueError) as error:
             raise _Refused(f"animate: {path}: the run's scenario attribute gives no interaction.radius") from error
-        sub = ds.isel(time=evenly(ds.sizes["time"], max_frames), agent=evenly(ds.sizes["agent"], MAX_AGENTS_DRAWN))
+        sub = ds.isel(time=_evenly(ds.sizes["time"], max_frames), agent=_evenly(ds.sizes["agent"], MAX_AGENTS_DRAWN))
         pos = sub["P"].values.astype(float)
         active = sub["active"].values.astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
         # Edges whose two agents are both drawn (``pair_i``/``pair_j`` hold agent indices).
-        col_i, ok_i = columns(sub["agent"].values, ds["pair_i"].values)
-        col_j, ok_j = columns(sub["agent"].values, ds["pair_j"].values)
+        col_i, ok_i = _columns(sub["agent"].values, ds["pair_i"].values)
+        col_j, ok_j = _columns(sub["agent"].values, ds["pair_j"].values)
         kept = np.flatnonzero(ok_i & ok_j)
         if "d_t" in ds:
             d_t = ds["d_t"].values[kept].astype(float)

@@ -1,4 +1,4 @@
-"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` or ``view`` a run, ``sweep`` many.
+"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` a run, ``sweep`` many.
 
 User mistakes (a bad scenario, an unusable output directory) end with one
 line on standard error naming the field and the reason, exit status 2 and no
@@ -189,39 +189,6 @@ def animate_command(
     _say(f"written {path}")
 
 
-@app.command("view")
-def view_command(
-    run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run` (1-D, 2-D or 3-D)."),
-    out: Path = typer.Option(None, "--out", "-o", help="The HTML file; default RUN_DIR.html beside the run directory."),
-    max_agents: int = typer.Option(None, help="Most agents shown; larger swarms are thinned evenly. Default 1000."),
-    max_frames: int = typer.Option(None, help="Most recorded times shown. Default 1000, fewer for large swarms."),
-) -> None:
-    """Write a viewer of a run: one HTML file that plays it in a browser, offline.
-
-    \f
-    Parameters
-    ----------
-    run_dir : Path
-        A run directory written by ``tmem run``.
-    out : Path or None
-        The HTML file; default ``RUN_DIR.html`` beside the run directory.
-    max_agents : int or None
-        Most agents shown; default :data:`tmem.viewer.data.MAX_AGENTS`.
-    max_frames : int or None
-        Most recorded times shown; default :data:`tmem.viewer.data.MAX_FRAMES`, fewer for large swarms.
-    """
-    for option, value in (("--max-agents", max_agents), ("--max-frames", max_frames)):
-        if value is not None and value < 1:
-            _fail(f"{option}: must be at least 1, got {value}")
-    from .viewer import MAX_AGENTS, write_view
-
-    try:
-        path = write_view(run_dir, out, max_agents=max_agents or MAX_AGENTS, max_frames=max_frames)
-    except ValueError as exc:
-        _fail(str(exc))
-    _say(f"written {path}")
-
-
 @app.command("sweep")
 def sweep_command(
     sweep_file: Path = typer.Argument(..., help="Sweep TOML file (see examples/sweeps/ and docs/sweeps.md)."),
@@ -273,6 +240,39 @@ def sweep_command(
         f"{len(outcome.table)} cases ({outcome.ran} run now, {outcome.failed} failed) in {outcome.seconds:.1f} s; "
         f"written to {out}/results.parquet and {out}/summary.md"
     )
+
+
+@app.command("view")
+def view_command(
+    run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run` (1-D, 2-D or 3-D)."),
+    out: Path = typer.Option(None, "--out", "-o", help="The HTML file; default RUN_DIR.html beside the run directory."),
+    max_agents: int = typer.Option(None, help="Most agents shown; larger swarms are thinned evenly. Default 1000."),
+    max_frames: int = typer.Option(None, help="Most recorded times shown. Default 1000, fewer for large swarms."),
+) -> None:
+    """Write a viewer of a run: one HTML file that plays it in a browser, offline.
+
+    \f
+    Parameters
+    ----------
+    run_dir : Path
+        A run directory written by ``tmem run``.
+    out : Path or None
+        The HTML file; default ``RUN_DIR.html`` beside the run directory.
+    max_agents : int or None
+        Most agents shown; default :data:`tmem.viewer.data.MAX_AGENTS`.
+    max_frames : int or None
+        Most recorded times shown; default :data:`tmem.viewer.data.MAX_FRAMES`, fewer for large swarms.
+    """
+    for option, value in (("--max-agents", max_agents), ("--max-frames", max_frames)):
+        if value is not None and value < 1:
+            _fail(f"{option}: must be at least 1, got {value}")
+    from .viewer import MAX_AGENTS, write_view
+
+    try:
+        path = write_view(run_dir, out, max_agents=max_agents or MAX_AGENTS, max_frames=max_frames)
+    except ValueError as exc:
+        _fail(str(exc))
+    _say(f"written {path}")
 
 
 def main() -> None:

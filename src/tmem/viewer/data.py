@@ -14,13 +14,15 @@ The state variables are named by the run's vehicle model
 
 from __future__ import annotations
 
+import gc
 import json
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-from ..readback import columns, evenly, quiet_unraisable, reason
 
 #: Most agents shown; larger runs are thinned evenly to this many.
 MAX_AGENTS = 1000
@@ -115,6 +117,39 @@ class View:
     note: str = ""
 
 
+def _evenly(n: int, at_most: int) -> np.ndarray:
+    """At most ``at_most`` indices into ``range(n)``, evenly spread, the first and the last kept."""
+    if n <= at_most:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, at_most)).astype(int))
+
+
+def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where each of ``wanted`` (agent numbers) is in ``ids`` (the agents kept), and whether it is there."""
+    order = np.argsort(ids)
+    k = order[np.clip(np.searchsorted(ids, wanted, sorter=order), 0, len(ids) - 1)]
+    return k, ids[k] == wanted
+
+
+@contextmanager
+def _quiet_unraisable() -> Iterator[None]:
+    """Silence errors raised while objects are freed (h5netcdf's half-opened file on a damaged one)."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = hook
+
+
+def _reason(exc: Exception) -> str:
+    """An exception as a short phrase of one line: its message, or its class when it has none."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    text = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
 def run_files(run_dir: Path) -> tuple[Path, Path]:
     """``run_dir``'s ``trajectory.nc`` and ``summary.json``; refuse, in one line, a directory that is not a run.
 
@@ -141,7 +176,7 @@ def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int
     run_dir : str or Path
         A directory written by ``tmem run``.
     max_agents : int
-        Most agents shown; more are thinned evenly (:func:`tmem.readback.evenly`).
+        Most agents shown; more are thinned evenly by number (the first and the last kept).
     max_frames : int, optional
         Most recorded times shown.  Default: :data:`MAX_FRAMES`, fewer if the
         frames would hold more than :data:`MAX_COORDINATES` coordinates.
@@ -157,15 +192,15 @@ def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int
     try:
         headline = _headline(json.loads(summary.read_text(encoding="utf-8")))
     except (OSError, UnicodeDecodeError, ValueError, AttributeError) as exc:
-        raise NotARun(f"{summary}: cannot be read as a run's summary ({reason(exc)})") from None
+        raise NotARun(f"{summary}: cannot be read as a run's summary ({_reason(exc)})") from None
     message = None
-    with quiet_unraisable():
+    with _quiet_unraisable():
         try:
             view = _read(trajectory, max_agents, max_frames)
         except NotARun:
             raise
         except Exception as exc:  # noqa: BLE001 - a damaged file fails in h5py, h5netcdf or NumPy, each its own way
-            message = f"{trajectory}: cannot be read as a run's trajectory ({reason(exc)})"
+            message = f"{trajectory}: cannot be read as a run's trajectory ({_reason(exc)})"
     if message is not None:
         raise NotARun(message)  # outside the handler: the failed file is freed, quietly, before this
     view.headline = headline
@@ -210,10 +245,10 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
         n_times, n_agents, n_axes = variables[model.state_names[model.POSITION]].shape
         if n_times == 0 or n_agents == 0:
             raise NotARun(f"{path}: the run recorded no times or no agents")
-        agents = evenly(n_agents, max_agents)
+        agents = _evenly(n_agents, max_agents)
         if max_frames is None:
             max_frames = min(MAX_FRAMES, max(2, MAX_COORDINATES // (len(agents) * n_axes)))
-        frames = evenly(n_times, max_frames)
+        frames = _evenly(n_times, max_frames)
 
         def at_frames(name: str, columns: np.ndarray | None = None) -> np.ndarray:
             return _at_frames(variables[name], frames, columns)
@@ -268,17 +303,17 @@ def agent_status(active: np.ndarray) -> np.ndarray:
 
 def _edges_between(kept: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     """The pairs (indices into ``pairs``) whose two agents are both kept."""
-    _, found_i = columns(kept, pairs[:, 0])
-    _, found_j = columns(kept, pairs[:, 1])
+    _, found_i = _columns(kept, pairs[:, 0])
+    _, found_j = _columns(kept, pairs[:, 1])
     return np.flatnonzero(found_i & found_j)
 
 
 def _edges(kept: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Formation edges between kept agents (as their columns), at most :data:`MAX_EDGES`, and their pairs."""
     between = _edges_between(kept, pairs)
-    drawn = between[evenly(len(between), MAX_EDGES)]
-    col_i, _ = columns(kept, pairs[drawn, 0])
-    col_j, _ = columns(kept, pairs[drawn, 1])
+    drawn = between[_evenly(len(between), MAX_EDGES)]
+    col_i, _ = _columns(kept, pairs[drawn, 0])
+    col_j, _ = _columns(kept, pairs[drawn, 1])
     return np.stack([col_i, col_j], axis=1).reshape(-1, 2), drawn
 
 
