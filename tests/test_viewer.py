@@ -217,7 +217,9 @@ def test_view_help_loads_nothing_heavy():
 
 def test_the_help_gives_the_defaults_the_viewer_uses(runner):
     text = " ".join(runner.invoke(app, ["view", "--help"], env={"COLUMNS": "200"}).output.split())
-    assert f"Default {MAX_AGENTS}." in text and f"Default {MAX_FRAMES}, fewer for large swarms." in text
+    agents, frames = (line for line in text.split("--")[1:] if line.startswith(("max-agents", "max-frames")))
+    assert "[default:" in agents and f"{MAX_AGENTS} agents" in agents
+    assert "[default:" in frames and f"{MAX_FRAMES} frames, fewer for large swarms" in frames
 
 
 def test_an_existing_file_is_replaced_only_if_tmem_view_wrote_it(runner, tmp_path):

@@ -244,10 +244,12 @@ def sweep_command(
 
 @app.command("view")
 def view_command(
-    run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run` (1-D, 2-D or 3-D)."),
-    out: Path = typer.Option(None, "--out", "-o", help="The HTML file; default RUN_DIR.html beside the run directory."),
-    max_agents: int = typer.Option(None, help="Most agents shown; larger swarms are thinned evenly. Default 1000."),
-    max_frames: int = typer.Option(None, help="Most recorded times shown. Default 1000, fewer for large swarms."),
+    run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run directory written by tmem run (1-D, 2-D or 3-D)."),
+    out: Path = typer.Option(
+        None, "--out", "-o", show_default="RUN_DIR.html beside RUN_DIR", help="The HTML file; replaced only if tmem view wrote it."
+    ),
+    max_agents: int = typer.Option(None, show_default="1000 agents", help="Most agents shown; larger swarms are thinned evenly."),
+    max_frames: int = typer.Option(None, show_default="1000 frames, fewer for large swarms", help="Most recorded times shown."),
 ) -> None:
     """Write a viewer of a run: one HTML file that plays it in a browser, offline.
 
