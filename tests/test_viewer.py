@@ -21,9 +21,9 @@ from typer.testing import CliRunner
 from tmem.cli import app
 from tmem.model.linear import LinearModel
 from tmem.viewer import default_out, write_view
-from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, NotARun, agent_status, read_view, strain_scale
+from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, STRAIN_FLOOR, NotARun, agent_status, read_view, strain_scale
 from tmem.viewer import data
-from tmem.viewer.page import VIEW_MARK, quantised
+from tmem.viewer.page import VIEW_MARK, headline, quantised
 
 VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
 
@@ -117,7 +117,7 @@ def test_edges_join_the_right_agents_and_their_strain_is_the_geometry(tmp_path):
     assert view.pair_labels == ["agents 4–1", "agents 2–5", "agents 3–4"]
 
 
-def test_strain_scale_is_the_99th_percentile_of_the_coupled_edges():
+def test_strain_scale_is_the_largest_strain_of_the_coupled_edges_between_flying_agents():
     rng = np.random.default_rng(2)
     strain = rng.uniform(-0.03, 0.03, (200, 10))
     coupled = np.ones_like(strain, bool)
@@ -125,9 +125,12 @@ def test_strain_scale_is_the_99th_percentile_of_the_coupled_edges():
     strain[:, 5:] = 5.0  # uncoupled edges far off d_t do not stretch the scale
     status = np.ones((200, 11), np.uint8)
     edges = np.stack([np.arange(10), np.arange(1, 11)], axis=1)
-    assert strain_scale(strain, coupled, status, edges) == pytest.approx(np.percentile(np.abs(strain[:, :5]), 99))
-    assert strain_scale(strain, np.zeros_like(coupled), status, edges) == pytest.approx(5.0)  # none coupled: every edge
-    assert strain_scale(np.zeros_like(strain), coupled, status, edges) == 1e-3  # a rigid formation: the smallest scale
+    assert strain_scale(strain, coupled, status, edges) == np.abs(strain[:, :5]).max()
+    status[7, 0] = REMOVED  # edge 0 at frame 7 is not drawn: its strain does not count
+    strain[7, 0] = -0.2
+    assert strain_scale(strain, coupled, status, edges) == np.abs(np.delete(strain[:, :5].ravel(), 7 * 5)).max()
+    assert strain_scale(strain, np.zeros_like(coupled), status, edges) == 5.0  # none coupled: every edge
+    assert strain_scale(strain / 100, coupled, status, edges) == STRAIN_FLOOR  # held to millimetres
 
 
 def test_agents_are_waiting_flying_or_removed(tmp_path):
@@ -256,6 +259,14 @@ def test_the_page_fetches_nothing(tmp_path):
     imports = json.loads(re.search(r'<script type="importmap">(.*?)</script>', page, re.S).group(1))["imports"]
     assert imports and all(url.startswith("data:text/javascript;base64,") for url in imports.values())
     assert page.count("</script>") == page.count("<script")  # nothing inlined closes a script early
+
+
+def test_the_headline_shows_the_summary_and_a_dash_for_what_is_missing():
+    summary = {"agents": 19, "function": "improved", "duration": 60.0, "rms_change_percent": None,
+               "min_distance": 33.076, "pairs_coupled_at_end": 40, "pairs": [{}] * 42}  # fmt: skip
+    assert dict(headline(summary)) == {"agents": "19", "function": "improved", "duration": "60 s", "ΔRMS": "—",
+                                       "min distance": "33.08 m", "pairs coupled at end": "40/42"}  # fmt: skip
+    assert dict(headline({"agents": True})) == {"agents": "—", "function": "—", "duration": "—", "ΔRMS": "—", "min distance": "—"}
 
 
 def test_a_name_with_markup_is_shown_as_written(tmp_path):

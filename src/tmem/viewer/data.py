@@ -38,6 +38,8 @@ MAX_EDGES = 3000
 MAX_PAIR_LINES = 60
 #: Most values read from the file at once (a block of frames of a large swarm).
 _READ_VALUES = 20_000_000
+#: The smallest end of the strain colour scale (1 %), as in the run's figures.
+STRAIN_FLOOR = 0.01
 #: Codes of an agent's state in :attr:`View.status`.
 WAITING, FLYING, REMOVED = 0, 1, 2
 
@@ -89,8 +91,8 @@ class View:
         Each pair's distance ``|P_j - P_i|`` (m), or the smallest, median and largest over the pairs.
     d_t : list of float
         The pairs' set distances (m), at most three of them, as reference lines.
-    headline : list of (str, str)
-        Figures of ``summary.json`` shown above the view.
+    summary : dict
+        ``summary.json`` as read (:func:`tmem.metrics.summarize`).
     note : str
         What is shown of the run, when it was thinned; empty when everything is.
     """
@@ -113,7 +115,7 @@ class View:
     pair_labels: list[str]
     pair_distance: np.ndarray
     d_t: list[float]
-    headline: list[tuple[str, str]] = field(default_factory=list)
+    summary: dict = field(default_factory=dict)
     note: str = ""
 
 
@@ -190,8 +192,10 @@ def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int
     """
     trajectory, summary = run_files(Path(run_dir))
     try:
-        headline = _headline(json.loads(summary.read_text(encoding="utf-8")))
-    except (OSError, UnicodeDecodeError, ValueError, AttributeError) as exc:
+        figures = json.loads(summary.read_text(encoding="utf-8"))
+        if not isinstance(figures, dict):
+            raise ValueError("not a JSON object")
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise NotARun(f"{summary}: cannot be read as a run's summary ({_reason(exc)})") from None
     message = None
     with _quiet_unraisable():
@@ -203,7 +207,7 @@ def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int
             message = f"{trajectory}: cannot be read as a run's trajectory ({_reason(exc)})"
     if message is not None:
         raise NotARun(message)  # outside the handler: the failed file is freed, quietly, before this
-    view.headline = headline
+    view.summary = figures
     return view
 
 
@@ -236,7 +240,7 @@ def _at_frames(values, frames: np.ndarray, columns: np.ndarray | None = None) ->
 
 
 def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
-    """The :class:`View` of ``path``, a ``trajectory.nc`` (without the headline)."""
+    """The :class:`View` of ``path``, a ``trajectory.nc`` (without its summary)."""
     import h5netcdf
 
     with h5netcdf.File(path, "r") as f:
@@ -320,10 +324,11 @@ def _edges(kept: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 def strain_scale(strain: np.ndarray, coupled: np.ndarray, status: np.ndarray, edges: np.ndarray) -> float:
     """The end of the symmetric colour scale of edge strain, fitted to the run.
 
-    The 99th percentile of ``|strain|`` over the coupled edges between flying
-    agents at every frame shown (over every edge between flying agents if none
-    is coupled), so that a formation holding ``d_t`` within 1 % uses the whole
-    scale; at least 0.1 %.
+    The largest ``|strain|`` of the coupled edges between flying agents at the
+    frames shown (of every edge between flying agents if none is coupled), at
+    least :data:`STRAIN_FLOOR`: the rule of the run's figures, so that a
+    formation holding ``d_t`` within 4 % uses the whole scale, and one held
+    to millimetres is drawn in the colour of ``d_t``.
 
     Parameters
     ----------
@@ -339,7 +344,7 @@ def strain_scale(strain: np.ndarray, coupled: np.ndarray, status: np.ndarray, ed
     flying = (status[:, edges[:, 0]] == FLYING) & (status[:, edges[:, 1]] == FLYING)
     chosen = flying & coupled if (flying & coupled).any() else flying
     values = np.abs(strain[chosen & np.isfinite(strain)])
-    return max(float(np.percentile(values, 99)) if values.size else 0.0, 1e-3)
+    return max(float(values.max(initial=0.0)), STRAIN_FLOOR)
 
 
 def _pair_series(distance: np.ndarray, pairs: np.ndarray) -> tuple[list[str], np.ndarray]:
@@ -376,22 +381,3 @@ def thinning_note(agents: int, agents_recorded: int, frames: int, times_recorded
     if edges < edges_between:
         parts.append(f"{edges} of the {edges_between} formation edges between them")
     return "Shown: " + "; ".join(parts) + "." if parts else ""
-
-
-def _number(value, form: str, unit: str = "") -> str:
-    return "—" if not isinstance(value, (int, float)) or isinstance(value, bool) else form.format(value) + unit
-
-
-def _headline(summary: dict) -> list[tuple[str, str]]:
-    """The figures of ``summary.json`` shown above the view."""
-    pairs = summary.get("pairs")
-    rows = [
-        ("agents", _number(summary.get("agents"), "{:d}")),
-        ("function", str(summary.get("function", "—"))),
-        ("duration", _number(summary.get("duration"), "{:g}", " s")),
-        ("ΔRMS", _number(summary.get("rms_change_percent"), "{:+.3f}", " %")),
-        ("min distance", _number(summary.get("min_distance"), "{:.2f}", " m")),
-    ]
-    if isinstance(pairs, list) and pairs:
-        rows.append(("pairs coupled at end", f"{_number(summary.get('pairs_coupled_at_end'), '{:d}')}/{len(pairs)}"))
-    return rows

@@ -74,6 +74,31 @@ def quantised(values: np.ndarray, axis_last: bool = True) -> dict:
     return {"low": low.tolist(), "step": step.tolist(), "data": _b64(q, "<u2")}
 
 
+def _number(value, form: str, unit: str = "") -> str:
+    return "—" if not isinstance(value, (int, float)) or isinstance(value, bool) else form.format(value) + unit
+
+
+def headline(summary: dict) -> list[tuple[str, str]]:
+    """The figures of ``summary.json`` shown above the view, as (label, text); "—" for one missing.
+
+    Parameters
+    ----------
+    summary : dict
+        ``summary.json`` as read (:func:`tmem.metrics.summarize`).
+    """
+    pairs = summary.get("pairs")
+    rows = [
+        ("agents", _number(summary.get("agents"), "{:d}")),
+        ("function", str(summary.get("function", "—"))),
+        ("duration", _number(summary.get("duration"), "{:g}", " s")),
+        ("ΔRMS", _number(summary.get("rms_change_percent"), "{:+.3f}", " %")),
+        ("min distance", _number(summary.get("min_distance"), "{:.2f}", " m")),
+    ]
+    if isinstance(pairs, list) and pairs:
+        rows.append(("pairs coupled at end", f"{_number(summary.get('pairs_coupled_at_end'), '{:d}')}/{len(pairs)}"))
+    return rows
+
+
 def page_data(view: View) -> dict:
     """The run as the page's scripts read it (``run.js``): plain JSON and base64 typed arrays.
 
@@ -102,7 +127,7 @@ def page_data(view: View) -> dict:
         "pairLabels": view.pair_labels,
         "pairDistance": _b64(view.pair_distance, "<f4"),
         "dT": view.d_t,
-        "headline": view.headline,
+        "headline": headline(view.summary),
         "note": view.note,
     }
 
