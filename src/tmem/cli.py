@@ -322,6 +322,41 @@ def sweep_command(
     )
 
 
+@app.command("view")
+def view_command(
+    run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run directory written by tmem run (1-D, 2-D or 3-D)."),
+    out: Path = typer.Option(
+        None, "--out", "-o", show_default="RUN_DIR.html beside RUN_DIR", help="The HTML file; replaced only if tmem view wrote it."
+    ),
+    max_agents: int = typer.Option(None, show_default="1000 agents", help="Most agents shown; larger swarms are thinned evenly."),
+    max_frames: int = typer.Option(None, show_default="1000 frames, fewer for large swarms", help="Most recorded times shown."),
+) -> None:
+    """Write a viewer of a run: one HTML file that plays it in a browser, offline.
+
+    \f
+    Parameters
+    ----------
+    run_dir : Path
+        A run directory written by ``tmem run``.
+    out : Path or None
+        The HTML file; default ``RUN_DIR.html`` beside the run directory.
+    max_agents : int or None
+        Most agents shown; default :data:`tmem.viewer.data.MAX_AGENTS`.
+    max_frames : int or None
+        Most recorded times shown; default :data:`tmem.viewer.data.MAX_FRAMES`, fewer for large swarms.
+    """
+    for option, value in (("--max-agents", max_agents), ("--max-frames", max_frames)):
+        if value is not None and value < 1:
+            _fail(f"{option}: must be at least 1, got {value}")
+    from .viewer import MAX_AGENTS, write_view
+
+    try:
+        path = write_view(run_dir, out, max_agents=max_agents or MAX_AGENTS, max_frames=max_frames)
+    except ValueError as exc:
+        _fail(str(exc))
+    _say(f"written {path}")
+
+
 def main() -> None:
     """Entry point of the ``tmem`` console script."""
     from .outputs import handle_termination, ignore_interrupts

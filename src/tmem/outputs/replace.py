@@ -174,7 +174,8 @@ def check_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out ")
         The output file.
     mark : str
         The text an existing file must hold (in its first 64 KiB or last
-        1 MiB) to be replaced: tmem wrote it.
+        1 MiB) to be replaced: tmem wrote it.  It reads after "was not" in
+        the message: ``"written by tmem animate"``.
     label : str
         Put before ``out`` in the message, such as ``"--out "``.
 
@@ -204,7 +205,7 @@ def _check_file(out: Path, mark: str, where: str) -> Path:
         if parent.exists() and not parent.is_dir():
             raise OutputError(f"{where}: {parent} is a file, not a directory")
     if out.exists() and not _has_mark(out, mark.encode()):
-        raise OutputError(f"{where}: exists and was not written by tmem animate; choose another --out or remove it")
+        raise OutputError(f"{where}: exists and was not {mark}; choose another --out or remove it")
     return out
 
 

@@ -1,0 +1,383 @@
+"""What the viewer shows of a run, read from the run directory and thinned to fit one page.
+
+:func:`read_view` reads ``trajectory.nc`` and ``summary.json`` (as
+:func:`tmem.io.write_run_files` writes them) into a :class:`View`: the agents
+and recorded times kept, the positions and speeds at those times, each agent's
+state (not yet flying, flying, removed), the formation edges between kept
+agents with their strain ``(|d| - d_t) / d_t`` and flag ``F_en``, and the
+series of the linked panels (RMS velocity, pair distances).
+
+The state variables are named by the run's vehicle model
+(:attr:`tmem.model.base.VehicleModel.state_names`, at its ``POSITION`` and
+``VELOCITY`` indices), built from the scenario the file carries.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+#: Most agents shown; larger runs are thinned evenly to this many.
+MAX_AGENTS = 1000
+#: Most recorded times shown (frames), when no ``max_frames`` is given.
+MAX_FRAMES = 1000
+#: Most coordinates (frames x agents x axes) stored when no ``max_frames`` is given: the
+#: frames of large swarms are thinned further, so that the page stays a few megabytes.
+MAX_COORDINATES = 600_000
+#: Most formation edges drawn (between agents shown); more are thinned evenly.
+MAX_EDGES = 3000
+#: Most pairs drawn one line each in the distance panel; more are drawn as their
+#: smallest, median and largest distance.
+MAX_PAIR_LINES = 60
+#: Most values read from the file at once (a block of frames of a large swarm).
+_READ_VALUES = 20_000_000
+#: The smallest end of the strain colour scale (1 %), as in the run's figures.
+STRAIN_FLOOR = 0.01
+#: Codes of an agent's state in :attr:`View.status`.
+WAITING, FLYING, REMOVED = 0, 1, 2
+
+
+class NotARun(ValueError):
+    """A directory that is not a readable run; the message is one line."""
+
+
+@dataclass
+class View:
+    """What the page shows: a run's kept agents at its kept times.
+
+    Attributes
+    ----------
+    name : str
+        The scenario's name.
+    axis_names : list of str
+        ``x``, ``y``, ``z``: one per axis of the run (1 to 3).
+    radius : float
+        ``R`` (m), the radius of each agent's interaction sphere.
+    reach : float
+        ``R + R_j`` (m): agents interact closer than this.
+    space : dict
+        ``box`` (sides, m, or None), ``periodic``, ``walls`` and ``obstacles``
+        (``center``, ``radius``) of the scenario's space.
+    agents : ndarray of int, shape (A,)
+        The kept agents, numbered from 1 as in the paper (the scenario's index + 1).
+    time : ndarray, shape (F,)
+        The kept recorded times (s).
+    position : ndarray, shape (F, A, axes)
+        Positions (m); a removed agent stays where it stopped (the engine holds it there).
+    speed : ndarray, shape (F, A)
+        Speeds ``|V|`` (m/s).
+    status : ndarray of uint8, shape (F, A)
+        :data:`WAITING` (not yet added), :data:`FLYING` or :data:`REMOVED`.
+    edges : ndarray of int, shape (E, 2)
+        Formation edges between kept agents, as columns of ``position``.
+    strain : ndarray, shape (F, E)
+        ``(|P_j - P_i| - d_t) / d_t`` of each edge.
+    coupled : ndarray of bool, shape (F, E)
+        ``F_en = 1``.
+    strain_scale : float
+        The end of the symmetric colour scale of strain, fitted to the run (:func:`strain_scale`).
+    rms : ndarray, shape (F,)
+        The RMS velocity of the recorded agents flying (m/s).
+    pair_labels : list of str
+        The name of each series of ``pair_distance``.
+    pair_distance : ndarray, shape (F, S)
+        Each pair's distance ``|P_j - P_i|`` (m), or the smallest, median and largest over the pairs.
+    d_t : list of float
+        The pairs' set distances (m), at most three of them, as reference lines.
+    summary : dict
+        ``summary.json`` as read (:func:`tmem.metrics.summarize`).
+    note : str
+        What is shown of the run, when it was thinned; empty when everything is.
+    """
+
+    name: str
+    axis_names: list[str]
+    radius: float
+    reach: float
+    space: dict
+    agents: np.ndarray
+    time: np.ndarray
+    position: np.ndarray
+    speed: np.ndarray
+    status: np.ndarray
+    edges: np.ndarray
+    strain: np.ndarray
+    coupled: np.ndarray
+    strain_scale: float
+    rms: np.ndarray
+    pair_labels: list[str]
+    pair_distance: np.ndarray
+    d_t: list[float]
+    summary: dict = field(default_factory=dict)
+    note: str = ""
+
+
+def _evenly(n: int, at_most: int) -> np.ndarray:
+    """At most ``at_most`` indices into ``range(n)``, evenly spread, the first and the last kept."""
+    if n <= at_most:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, at_most)).astype(int))
+
+
+def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where each of ``wanted`` (agent numbers) is in ``ids`` (the agents kept), and whether it is there."""
+    order = np.argsort(ids)
+    k = order[np.clip(np.searchsorted(ids, wanted, sorter=order), 0, len(ids) - 1)]
+    return k, ids[k] == wanted
+
+
+@contextmanager
+def _quiet_unraisable() -> Iterator[None]:
+    """Silence errors raised while objects are freed (h5netcdf's half-opened file on a damaged one)."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = hook
+
+
+def _reason(exc: Exception) -> str:
+    """An exception as a short phrase of one line: its message, or its class when it has none."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    text = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def run_files(run_dir: Path) -> tuple[Path, Path]:
+    """``run_dir``'s ``trajectory.nc`` and ``summary.json``; refuse, in one line, a directory that is not a run.
+
+    Parameters
+    ----------
+    run_dir : Path
+        A directory written by ``tmem run``.
+    """
+    if not run_dir.exists():
+        raise NotARun(f"{run_dir}: no such directory")
+    if not run_dir.is_dir():
+        raise NotARun(f"{run_dir}: is a file, not a run directory; give the directory tmem run wrote")
+    missing = [name for name in ("trajectory.nc", "summary.json") if not (run_dir / name).is_file()]
+    if missing:
+        raise NotARun(f"{run_dir}: is not a run directory (no {' and no '.join(missing)}); give one written by tmem run")
+    return run_dir / "trajectory.nc", run_dir / "summary.json"
+
+
+def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int | None = None) -> View:
+    """Read what the page shows of the run in ``run_dir``.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        A directory written by ``tmem run``.
+    max_agents : int
+        Most agents shown; more are thinned evenly by number (the first and the last kept).
+    max_frames : int, optional
+        Most recorded times shown.  Default: :data:`MAX_FRAMES`, fewer if the
+        frames would hold more than :data:`MAX_COORDINATES` coordinates.
+
+    Raises
+    ------
+    NotARun
+        One line: no such directory, no ``trajectory.nc`` or ``summary.json``
+        in it, or a file that cannot be read as a run's (damaged, truncated,
+        without its scenario).
+    """
+    trajectory, summary = run_files(Path(run_dir))
+    try:
+        figures = json.loads(summary.read_text(encoding="utf-8"))
+        if not isinstance(figures, dict):
+            raise ValueError("not a JSON object")
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise NotARun(f"{summary}: cannot be read as a run's summary ({_reason(exc)})") from None
+    message = None
+    with _quiet_unraisable():
+        try:
+            view = _read(trajectory, max_agents, max_frames)
+        except NotARun:
+            raise
+        except Exception as exc:  # noqa: BLE001 - a damaged file fails in h5py, h5netcdf or NumPy, each its own way
+            message = f"{trajectory}: cannot be read as a run's trajectory ({_reason(exc)})"
+    if message is not None:
+        raise NotARun(message)  # outside the handler: the failed file is freed, quietly, before this
+    view.summary = figures
+    return view
+
+
+def _scenario_and_model(text, path: Path):
+    """The run's scenario (from the file's ``scenario`` attribute) and its vehicle model."""
+    from ..model import vehicle_model
+    from ..scenario import ScenarioError, loads
+
+    if not isinstance(text, str):
+        raise NotARun(f"{path}: carries no scenario; give a run written by tmem run")
+    try:
+        scenario = loads(text, source="its scenario")
+    except ScenarioError as exc:
+        raise NotARun(f"{path}: {exc}") from None
+    return scenario, vehicle_model(scenario.model)
+
+
+def _at_frames(values, frames: np.ndarray, columns: np.ndarray | None = None) -> np.ndarray:
+    """``values[frames][:, columns]`` of a variable over (time, ...), read a block of frames at a time
+    so that a large swarm's file is never in memory whole."""
+    if 0 in values.shape:  # no pairs: HDF5 selects nothing from an empty dataset
+        return np.zeros((len(frames), *values.shape[1:]), values.dtype)
+    every = len(frames) == values.shape[0]
+    step = max(1, _READ_VALUES // int(np.prod(values.shape[1:])))
+    blocks = []
+    for start in range(0, len(frames), step):
+        block = np.asarray(values[start : start + step] if every else values[frames[start : start + step]])
+        blocks.append(block if columns is None else block[:, columns])
+    return np.concatenate(blocks)
+
+
+def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
+    """The :class:`View` of ``path``, a ``trajectory.nc`` (without its summary)."""
+    import h5netcdf
+
+    with h5netcdf.File(path, "r") as f:
+        scenario, model = _scenario_and_model(f.attrs.get("scenario"), path)
+        variables = f.variables
+        n_times, n_agents, n_axes = variables[model.state_names[model.POSITION]].shape
+        if n_times == 0 or n_agents == 0:
+            raise NotARun(f"{path}: the run recorded no times or no agents")
+        agents = _evenly(n_agents, max_agents)
+        if max_frames is None:
+            max_frames = min(MAX_FRAMES, max(2, MAX_COORDINATES // (len(agents) * n_axes)))
+        frames = _evenly(n_times, max_frames)
+
+        def at_frames(name: str, columns: np.ndarray | None = None) -> np.ndarray:
+            return _at_frames(variables[name], frames, columns)
+
+        position = at_frames(model.state_names[model.POSITION], agents).astype(float)
+        speed = np.linalg.norm(at_frames(model.state_names[model.VELOCITY], agents), axis=-1)
+        status = agent_status(at_frames("active", agents).astype(bool))
+        ids = np.asarray(variables["agent"][...])
+        pairs = np.stack([variables["pair_i"][...], variables["pair_j"][...]], axis=1).astype(int).reshape(-1, 2)
+        distance = at_frames("distance").reshape(len(frames), len(pairs)).astype(float)
+        d_t = np.asarray(variables["d_t"][...], dtype=float)
+        edges, edge_pairs = _edges(ids[agents], pairs)
+        strain = distance[:, edge_pairs] / d_t[edge_pairs] - 1.0
+        coupled = at_frames("F_en").reshape(len(frames), len(pairs))[:, edge_pairs] == 1
+        pair_labels, pair_distance = _pair_series(distance, pairs)
+        view = View(
+            name=scenario.name,
+            axis_names=["x", "y", "z"][:n_axes],
+            radius=scenario.interaction.radius,
+            reach=scenario.interaction.reach,
+            space=_space(scenario),
+            agents=ids[agents] + 1,
+            time=at_frames("time").astype(float),
+            position=position,
+            speed=speed,
+            status=status,
+            edges=edges,
+            strain=strain,
+            coupled=coupled,
+            strain_scale=strain_scale(strain, coupled, status, edges),
+            rms=at_frames("rms_velocity").astype(float),
+            pair_labels=pair_labels,
+            pair_distance=pair_distance,
+            d_t=[float(v) for v in np.unique(d_t)[:3]],
+        )
+    view.note = thinning_note(len(agents), n_agents, len(frames), n_times, len(edges), len(_edges_between(ids[agents], pairs)))
+    return view
+
+
+def agent_status(active: np.ndarray) -> np.ndarray:
+    """Each agent's state code at each frame: :data:`FLYING`, :data:`REMOVED` (not flying after it
+    flew) or :data:`WAITING` (not yet added).
+
+    Parameters
+    ----------
+    active : ndarray of bool, shape (F, A)
+        Whether each agent flies at each frame (the file's ``active``).
+    """
+    flown = np.maximum.accumulate(active, axis=0)
+    return np.where(active, FLYING, np.where(flown, REMOVED, WAITING)).astype(np.uint8)
+
+
+def _edges_between(kept: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """The pairs (indices into ``pairs``) whose two agents are both kept."""
+    _, found_i = _columns(kept, pairs[:, 0])
+    _, found_j = _columns(kept, pairs[:, 1])
+    return np.flatnonzero(found_i & found_j)
+
+
+def _edges(kept: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Formation edges between kept agents (as their columns), at most :data:`MAX_EDGES`, and their pairs."""
+    between = _edges_between(kept, pairs)
+    drawn = between[_evenly(len(between), MAX_EDGES)]
+    col_i, _ = _columns(kept, pairs[drawn, 0])
+    col_j, _ = _columns(kept, pairs[drawn, 1])
+    return np.stack([col_i, col_j], axis=1).reshape(-1, 2), drawn
+
+
+def strain_scale(strain: np.ndarray, coupled: np.ndarray, status: np.ndarray, edges: np.ndarray) -> float:
+    """The end of the symmetric colour scale of edge strain, fitted to the run.
+
+    The largest ``|strain|`` of the coupled edges between flying agents at the
+    frames shown (of every edge between flying agents if none is coupled), at
+    least :data:`STRAIN_FLOOR`: the rule of the run's figures, so that a
+    formation holding ``d_t`` within 4 % uses the whole scale, and one held
+    to millimetres is drawn in the colour of ``d_t``.
+
+    Parameters
+    ----------
+    strain : ndarray, shape (F, E)
+        ``(|d| - d_t) / d_t`` of each edge at each frame.
+    coupled : ndarray of bool, shape (F, E)
+        ``F_en = 1``.
+    status : ndarray of uint8, shape (F, A)
+        Each agent's state code.
+    edges : ndarray of int, shape (E, 2)
+        Each edge's agents, as columns of ``status``.
+    """
+    flying = (status[:, edges[:, 0]] == FLYING) & (status[:, edges[:, 1]] == FLYING)
+    chosen = flying & coupled if (flying & coupled).any() else flying
+    values = np.abs(strain[chosen & np.isfinite(strain)])
+    return max(float(values.max(initial=0.0)), STRAIN_FLOOR)
+
+
+def _pair_series(distance: np.ndarray, pairs: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """The distance panel's series: each pair (agents numbered from 1), or the smallest, median and largest."""
+    if len(pairs) <= MAX_PAIR_LINES:
+        return [f"agents {i + 1}–{j + 1}" for i, j in pairs], distance
+    envelope = np.stack([distance.min(axis=1), np.median(distance, axis=1), distance.max(axis=1)], axis=1)
+    return [f"smallest of {len(pairs)} pairs", "median", "largest"], envelope
+
+
+def _space(scenario) -> dict:
+    space = scenario.space
+    obstacles = [{"center": list(o.center), "radius": o.radius} for o in scenario.obstacles]
+    return {"box": space.box, "periodic": space.periodic, "walls": space.walls, "obstacles": obstacles}
+
+
+def thinning_note(agents: int, agents_recorded: int, frames: int, times_recorded: int, edges: int, edges_between: int) -> str:
+    """The page's note on what is shown of a thinned run; empty when everything is.
+
+    Parameters
+    ----------
+    agents, agents_recorded : int
+        Agents shown, of those the run recorded.
+    frames, times_recorded : int
+        Recorded times shown, of those the run recorded.
+    edges, edges_between : int
+        Formation edges drawn, of those between the agents shown.
+    """
+    parts = []
+    if agents < agents_recorded:
+        parts.append(f"{agents} of {agents_recorded} agents, evenly chosen by number")
+    if frames < times_recorded:
+        parts.append(f"{frames} of {times_recorded} recorded times, evenly spaced")
+    if edges < edges_between:
+        parts.append(f"{edges} of the {edges_between} formation edges between them")
+    return "Shown: " + "; ".join(parts) + "." if parts else ""
