@@ -15,7 +15,7 @@ from tmem.cli import app
 
 PYPROJECT = Path(__file__).parent.parent / "pyproject.toml"
 #: Words that name what an option's number counts or measures.
-UNITS = re.compile(r"\b(s|m|rad|m/s|frames|frames per second|processes|per core)\b")
+UNITS = re.compile(r"\b(s|m|rad|m/s|frames|frames per second|processes|per core|agents)\b")
 
 
 def commands() -> dict:

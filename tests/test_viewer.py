@@ -21,7 +21,9 @@ from typer.testing import CliRunner
 from tmem.cli import app
 from tmem.model.linear import LinearModel
 from tmem.viewer import default_out, write_view
-from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, STRAIN_FLOOR, NotARun, agent_status, read_view, strain_scale
+from tmem.drawing import STRAIN_FLOOR
+from tmem.saved import RunReadError
+from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, agent_status, read_view, strain_scale
 from tmem.viewer import data
 from tmem.viewer.page import VIEW_MARK, headline, quantised
 
@@ -172,7 +174,7 @@ def test_state_names_come_from_the_vehicle_model(tmp_path, monkeypatch):
     monkeypatch.setattr(LinearModel, "state_names", ("X", "Xdot", "tilt", "tilt_rate"))
     view = read_view(write_run(tmp_path / "renamed", names=("X", "Xdot", "tilt", "tilt_rate"), removed=False))
     assert view.position.shape == (30, 3, 2)
-    with pytest.raises(NotARun, match=r"cannot be read as a run's trajectory \(.*X"):
+    with pytest.raises(RunReadError, match=r"cannot be read as a run's trajectory \(.*X"):
         read_view(write_run(tmp_path / "usual", removed=False))
 
 
@@ -197,9 +199,9 @@ def test_what_is_not_a_run_is_refused_in_one_line_and_nothing_is_written(runner,
     bad_summary = write_run(tmp_path / "bad-summary")
     (bad_summary / "summary.json").write_text("{")
     before = sorted(p.name for p in tmp_path.iterdir())
-    assert "no such directory" in refused(runner, tmp_path / "missing")
-    assert "is a file, not a run directory" in refused(runner, run / "summary.json")
-    assert "no summary.json" in refused(runner, no_summary)
+    assert "no such folder" in refused(runner, tmp_path / "missing")
+    assert "is a file, not a run folder" in refused(runner, run / "summary.json")
+    assert "no summary.json in" in refused(runner, no_summary)
     assert "cannot be read as a run's summary" in refused(runner, bad_summary)
     assert "cannot be read as a run's trajectory" in refused(runner, damaged)
     assert "--max-frames: must be at least 1, got 0" in refused(runner, run, "--max-frames", "0")

@@ -19,10 +19,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..outputs import check_file, replace_file
-from .data import MAX_AGENTS, NotARun, read_view
+from ..saved import RunReadError
+from .data import MAX_AGENTS, read_view
 from .page import VIEW_MARK, render
 
-__all__ = ["MAX_AGENTS", "NotARun", "default_out", "write_view"]
+__all__ = ["MAX_AGENTS", "RunReadError", "default_out", "write_view"]
 
 
 def default_out(run_dir: str | Path) -> Path:
@@ -61,7 +62,7 @@ def write_view(run_dir: str | Path, out: str | Path | None = None, max_agents: i
     ------
     ValueError
         In one line: a limit below 1, a directory that is not a readable run
-        (:class:`NotARun`), or an ``out`` that may not be written
+        (:class:`~tmem.saved.RunReadError`), or an ``out`` that may not be written
         (:class:`tmem.outputs.OutputError`).  Nothing is written then; an
         interrupted write leaves ``out`` as it was.
     """

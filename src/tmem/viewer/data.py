@@ -14,15 +14,14 @@ The state variables are named by the run's vehicle model
 
 from __future__ import annotations
 
-import gc
 import json
-import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from ..drawing import columns_of, evenly, strain_limit
+from ..saved import RunReadError, reading, run_directory
 
 #: Most agents shown; larger runs are thinned evenly to this many.
 MAX_AGENTS = 1000
@@ -38,14 +37,8 @@ MAX_EDGES = 3000
 MAX_PAIR_LINES = 60
 #: Most values read from the file at once (a block of frames of a large swarm).
 _READ_VALUES = 20_000_000
-#: The smallest end of the strain colour scale (1 %), as in the run's figures.
-STRAIN_FLOOR = 0.01
 #: Codes of an agent's state in :attr:`View.status`.
 WAITING, FLYING, REMOVED = 0, 1, 2
-
-
-class NotARun(ValueError):
-    """A directory that is not a readable run; the message is one line."""
 
 
 @dataclass
@@ -119,57 +112,6 @@ class View:
     note: str = ""
 
 
-def _evenly(n: int, at_most: int) -> np.ndarray:
-    """At most ``at_most`` indices into ``range(n)``, evenly spread, the first and the last kept."""
-    if n <= at_most:
-        return np.arange(n)
-    return np.unique(np.round(np.linspace(0, n - 1, at_most)).astype(int))
-
-
-def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where each of ``wanted`` (agent numbers) is in ``ids`` (the agents kept), and whether it is there."""
-    order = np.argsort(ids)
-    k = order[np.clip(np.searchsorted(ids, wanted, sorter=order), 0, len(ids) - 1)]
-    return k, ids[k] == wanted
-
-
-@contextmanager
-def _quiet_unraisable() -> Iterator[None]:
-    """Silence errors raised while objects are freed (h5netcdf's half-opened file on a damaged one)."""
-    hook = sys.unraisablehook
-    sys.unraisablehook = lambda unraisable: None
-    try:
-        yield
-    finally:
-        gc.collect()
-        sys.unraisablehook = hook
-
-
-def _reason(exc: Exception) -> str:
-    """An exception as a short phrase of one line: its message, or its class when it has none."""
-    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
-    text = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
-    return text if len(text) <= 200 else text[:197] + "..."
-
-
-def run_files(run_dir: Path) -> tuple[Path, Path]:
-    """``run_dir``'s ``trajectory.nc`` and ``summary.json``; refuse, in one line, a directory that is not a run.
-
-    Parameters
-    ----------
-    run_dir : Path
-        A directory written by ``tmem run``.
-    """
-    if not run_dir.exists():
-        raise NotARun(f"{run_dir}: no such directory")
-    if not run_dir.is_dir():
-        raise NotARun(f"{run_dir}: is a file, not a run directory; give the directory tmem run wrote")
-    missing = [name for name in ("trajectory.nc", "summary.json") if not (run_dir / name).is_file()]
-    if missing:
-        raise NotARun(f"{run_dir}: is not a run directory (no {' and no '.join(missing)}); give one written by tmem run")
-    return run_dir / "trajectory.nc", run_dir / "summary.json"
-
-
 def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int | None = None) -> View:
     """Read what the page shows of the run in ``run_dir``.
 
@@ -185,28 +127,19 @@ def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int
 
     Raises
     ------
-    NotARun
-        One line: no such directory, no ``trajectory.nc`` or ``summary.json``
+    RunReadError
+        One line: no such folder, no ``trajectory.nc`` or ``summary.json``
         in it, or a file that cannot be read as a run's (damaged, truncated,
         without its scenario).
     """
-    trajectory, summary = run_files(Path(run_dir))
-    try:
+    run_dir = run_directory(run_dir, "view")
+    trajectory, summary = run_dir / "trajectory.nc", run_dir / "summary.json"
+    with reading(summary, "view", "a run's summary"):
         figures = json.loads(summary.read_text(encoding="utf-8"))
         if not isinstance(figures, dict):
             raise ValueError("not a JSON object")
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise NotARun(f"{summary}: cannot be read as a run's summary ({_reason(exc)})") from None
-    message = None
-    with _quiet_unraisable():
-        try:
-            view = _read(trajectory, max_agents, max_frames)
-        except NotARun:
-            raise
-        except Exception as exc:  # noqa: BLE001 - a damaged file fails in h5py, h5netcdf or NumPy, each its own way
-            message = f"{trajectory}: cannot be read as a run's trajectory ({_reason(exc)})"
-    if message is not None:
-        raise NotARun(message)  # outside the handler: the failed file is freed, quietly, before this
+    with reading(trajectory, "view"):
+        view = _read(trajectory, max_agents, max_frames)
     view.summary = figures
     return view
 
@@ -217,11 +150,11 @@ def _scenario_and_model(text, path: Path):
     from ..scenario import ScenarioError, loads
 
     if not isinstance(text, str):
-        raise NotARun(f"{path}: carries no scenario; give a run written by tmem run")
+        raise RunReadError(f"view: {path}: carries no scenario; give a run written by tmem run")
     try:
         scenario = loads(text, source="its scenario")
     except ScenarioError as exc:
-        raise NotARun(f"{path}: {exc}") from None
+        raise RunReadError(f"view: {path}: {exc}") from None
     return scenario, vehicle_model(scenario.model)
 
 
@@ -248,11 +181,11 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
         variables = f.variables
         n_times, n_agents, n_axes = variables[model.state_names[model.POSITION]].shape
         if n_times == 0 or n_agents == 0:
-            raise NotARun(f"{path}: the run recorded no times or no agents")
-        agents = _evenly(n_agents, max_agents)
+            raise RunReadError(f"view: {path}: the run recorded no times or no agents")
+        agents = evenly(n_agents, max_agents, "agents").index
         if max_frames is None:
             max_frames = min(MAX_FRAMES, max(2, MAX_COORDINATES // (len(agents) * n_axes)))
-        frames = _evenly(n_times, max_frames)
+        frames = evenly(n_times, max_frames, "frames").index
 
         def at_frames(name: str, columns: np.ndarray | None = None) -> np.ndarray:
             return _at_frames(variables[name], frames, columns)
@@ -307,17 +240,17 @@ def agent_status(active: np.ndarray) -> np.ndarray:
 
 def _edges_between(kept: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     """The pairs (indices into ``pairs``) whose two agents are both kept."""
-    _, found_i = _columns(kept, pairs[:, 0])
-    _, found_j = _columns(kept, pairs[:, 1])
+    _, found_i = columns_of(kept, pairs[:, 0])
+    _, found_j = columns_of(kept, pairs[:, 1])
     return np.flatnonzero(found_i & found_j)
 
 
 def _edges(kept: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Formation edges between kept agents (as their columns), at most :data:`MAX_EDGES`, and their pairs."""
     between = _edges_between(kept, pairs)
-    drawn = between[_evenly(len(between), MAX_EDGES)]
-    col_i, _ = _columns(kept, pairs[drawn, 0])
-    col_j, _ = _columns(kept, pairs[drawn, 1])
+    drawn = between[evenly(len(between), MAX_EDGES, "edges").index]
+    col_i, _ = columns_of(kept, pairs[drawn, 0])
+    col_j, _ = columns_of(kept, pairs[drawn, 1])
     return np.stack([col_i, col_j], axis=1).reshape(-1, 2), drawn
 
 
@@ -326,7 +259,7 @@ def strain_scale(strain: np.ndarray, coupled: np.ndarray, status: np.ndarray, ed
 
     The largest ``|strain|`` of the coupled edges between flying agents at the
     frames shown (of every edge between flying agents if none is coupled), at
-    least :data:`STRAIN_FLOOR`: the rule of the run's figures, so that a
+    least :data:`tmem.drawing.STRAIN_FLOOR`: the rule of the run's figures, so that a
     formation holding ``d_t`` within 4 % uses the whole scale, and one held
     to millimetres is drawn in the colour of ``d_t``.
 
@@ -343,8 +276,7 @@ def strain_scale(strain: np.ndarray, coupled: np.ndarray, status: np.ndarray, ed
     """
     flying = (status[:, edges[:, 0]] == FLYING) & (status[:, edges[:, 1]] == FLYING)
     chosen = flying & coupled if (flying & coupled).any() else flying
-    values = np.abs(strain[chosen & np.isfinite(strain)])
-    return max(float(values.max(initial=0.0)), STRAIN_FLOOR)
+    return strain_limit(strain[chosen])
 
 
 def _pair_series(distance: np.ndarray, pairs: np.ndarray) -> tuple[list[str], np.ndarray]:
