@@ -138,10 +138,20 @@ def _summary_table(rows: dict[str, dict]) -> Table:
     return table
 
 
+def _resuming(time: float) -> None:
+    console.print(f"going on from the checkpoint at t = {time:g} s", highlight=False, soft_wrap=True)
+
+
 @app.command()
 def run(
     scenario: Path = typer.Argument(..., metavar="SCENARIO", help="Scenario TOML file (see examples/)."),
     out: Path = typer.Option(..., "--out", "-o", help="Output directory; replaced only if it holds an earlier run."),
+    checkpoint_every: float = typer.Option(
+        None, "--checkpoint-every", metavar="SECONDS", show_default="none",
+        help="Save the run's whole state every SECONDS (s) of simulated time (not wall time; rounded to whole steps) "
+        "in .OUT.tmem-checkpoint.npz beside OUT. Killed, the same command run again goes on from the last one "
+        "and gives the same results; the file is removed once OUT is written.",
+    ),  # fmt: skip
 ) -> None:
     """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT.
 
@@ -154,21 +164,36 @@ def run(
         Scenario TOML file.
     out : Path
         Output directory (replaced if it holds an earlier run).
+    checkpoint_every : float or None
+        Simulated seconds between checkpoints (:mod:`tmem.engine.checkpoint`); None: no checkpoints.
     """
-    from .engine import SimulationError, simulate
+    from .engine import CheckpointError, Checkpoints, SimulationError, simulate
+    from .engine.checkpoint import checkpoint_path
     from .io import OutputError, check_output_directory, write_run
     from .scenario import ScenarioError, load
 
     progress = _LazyProgress()
+    checkpoints = None
     try:
         loaded = load(scenario)
         check_output_directory(out)
-        trajectory = simulate(loaded, progress=lambda done, total: progress(scenario.name, done, total))
+        if checkpoint_every is not None:
+            checkpoints = Checkpoints(checkpoint_path(out), checkpoint_every, on_resume=_resuming)
+        trajectory = simulate(loaded, progress=lambda done, total: progress(scenario.name, done, total), checkpoints=checkpoints)
         progress.close()
         summary = write_run(trajectory, out)
-    except (ScenarioError, OutputError, SimulationError) as exc:
+        if checkpoints is not None:
+            checkpoints.remove()
+    except (ScenarioError, OutputError, SimulationError, CheckpointError) as exc:
         progress.close()
         _fail(str(exc))
+    except KeyboardInterrupt:
+        progress.close()
+        if checkpoints is None or checkpoints.saved_time is None:
+            raise
+        said = f"interrupted; no output was written; the same command goes on from t = {checkpoints.saved_time:g} s"
+        console.print(said, highlight=False, soft_wrap=True)
+        raise typer.Exit(130) from None
     Console().print(_summary_table({loaded.name or scenario.stem: summary}))
     _say(f"written to {out}/")
 

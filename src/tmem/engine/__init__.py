@@ -10,6 +10,7 @@ the compiled loop runs it (:mod:`tmem.engine.loop`)::
 * :mod:`tmem.engine.stages` — one compiled function per stage;
 * :mod:`tmem.engine.loop` — the loop, compiled once per vehicle model;
 * :mod:`tmem.engine.driver` — builds the records from a scenario and drives the loop;
+* :mod:`tmem.engine.checkpoint` — a run's state saved at checkpoints, and the run resumed from one;
 * :mod:`tmem.engine.trajectory` — what a run returns.
 
 ``docs/architecture.md`` describes each stage and record, and how to extend them.
@@ -17,7 +18,8 @@ the compiled loop runs it (:mod:`tmem.engine.loop`)::
 
 from __future__ import annotations
 
+from .checkpoint import CheckpointError, Checkpoints
 from .driver import record_steps, simulate
 from .trajectory import DIVERGED, Event, SimulationError, Trajectory
 
-__all__ = ["DIVERGED", "Event", "SimulationError", "Trajectory", "record_steps", "simulate"]
+__all__ = ["DIVERGED", "CheckpointError", "Checkpoints", "Event", "SimulationError", "Trajectory", "record_steps", "simulate"]

@@ -6,7 +6,10 @@ compiled loop (:mod:`tmem.engine.loop`) in chunks that last about
 ``chunk_seconds``, so that a caller can show progress between them.  When the
 loop reports that the lists are stale (an agent's ``P*`` moved half the skin,
 or an agent was removed or added), it lists them again and goes on from the
-same step.  At the end it translates slots back to the scenario's agents.
+same step.  Given :class:`~tmem.engine.checkpoint.Checkpoints`, it ends chunks
+at the checkpoints' steps and saves the run there, and goes on from the last
+checkpoint a run left.  At the end it translates slots back to the scenario's
+agents.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from ..neighbors import all_pairs, arrange, spatial_order, verlet_pairs
 from ..scenario import Scenario
 from ..sensing import Sensing, exact
 from ..synchronise import coupled_mode, synchronising_gain
+from .checkpoint import Checkpoints, Saved, restore
 from .loop import advance_for
 from .stages import CHUNK
 from .gas import SNAPSHOT, TOTALS, gas_record, wall_params
@@ -245,6 +249,7 @@ def simulate(
     chunk_seconds: float = 0.1,
     record: bool = True,
     sensing: Sensing | None = None,
+    checkpoints: Checkpoints | None = None,
 ) -> Trajectory:
     """Run a scenario and return its :class:`~tmem.engine.trajectory.Trajectory`.
 
@@ -261,6 +266,9 @@ def simulate(
         ``False`` records nothing but the end state (for benchmarks).
     sensing
         What the agents know of each other (:mod:`tmem.sensing`); default: every state exactly.
+    checkpoints
+        Save the run's state at these checkpoints (:mod:`tmem.engine.checkpoint`), and go on from
+        the one a killed run of the same scenario left; default: none.
 
     Returns
     -------
@@ -270,7 +278,10 @@ def simulate(
     ------
     SimulationError
         If the run diverged.
+    CheckpointError
+        If the checkpoint file is not one this run made.
     """
+    resume = checkpoints.start(scenario, record, sensing) if checkpoints is not None else None
     sim, c = scenario.simulation, scenario.controller
     model = vehicle_model(scenario.model)
     gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
@@ -285,7 +296,7 @@ def simulate(
     sensing = exact(x) if sensing is None else sensing
     gas = gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0])
     stages = (law, params, model.step_params(sim.dt), sensing, gas, wall_params(params, gas.wall_reach))
-    _drive(advance, run, stages, swarm, lister, progress, chunk_seconds)
+    _drive(advance, run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)
     if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
     return Trajectory(
@@ -321,23 +332,40 @@ def _run_of(scenario: Scenario, initial: InitialArrays, record: bool) -> Run:
     return Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
 
 
-def _drive(advance, run: Run, stages: tuple, swarm: _Slots, lister: _NeighbourLister, progress, chunk_seconds: float) -> None:
+def _changing(swarm: _Slots, neighbours: Neighbours, stages: tuple) -> dict:
+    """The records a step changes, by the names of :data:`tmem.engine.checkpoint.CHANGING`."""
+    _, _, _, sensing, gas, _ = stages
+    return dict(agents=swarm.agents, pairs=swarm.pairs, neighbours=neighbours, records=swarm.records, events=swarm.events,
+                counters=swarm.counters, gas=gas, sensing=sensing)  # fmt: skip
+
+
+def _drive(advance, run: Run, stages: tuple, swarm: _Slots, lister: _NeighbourLister, progress, chunk_seconds: float,
+           checkpoints: Checkpoints | None, resume: Saved | None) -> None:  # fmt: skip
     """Run the compiled loop ``advance`` over every step, in chunks of about ``chunk_seconds``,
     listing the neighbours again whenever the loop asks.  ``stages`` are the records of the law and
-    the stages: ``(law, params, vehicle, sensing, gas, wall_params)``."""
+    the stages: ``(law, params, vehicle, sensing, gas, wall_params)``.  With ``checkpoints``, chunks
+    end at the checkpoints' steps, where the run is saved; with ``resume``, the run goes on from it,
+    its neighbours listed again from ``P*`` at their last build."""
     law, params, vehicle, sensing, gas, walls = stages
     neighbours = lister.list(swarm.agents.active, run.box)
+    if resume is not None:
+        restore(resume, _changing(swarm, neighbours, stages))
+        neighbours = lister.list(swarm.agents.active, run.box)
+        lister.builds = resume.list_builds
     counters = swarm.counters
     chunk = 1000
     while counters.step[0] <= run.n_steps:
         started = _time.perf_counter()
-        stop = min(counters.step[0] + chunk, run.n_steps + 1)
+        at = checkpoints.due(counters.step[0]) if checkpoints is not None else run.n_steps + 1
+        stop = min(counters.step[0] + chunk, run.n_steps + 1, at)
         status = advance(stop, run, law, params, vehicle, sensing, swarm.agents, swarm.pairs, neighbours, swarm.commands,
                          swarm.records, swarm.events, counters, gas, walls)  # fmt: skip
         if status == LISTS_STALE:
             neighbours = lister.list(swarm.agents.active, run.box)  # and go on from the same step
             continue
         elapsed = _time.perf_counter() - started
+        if counters.step[0] == at <= run.n_steps:
+            checkpoints.save(at, _changing(swarm, neighbours, stages), lister.builds)
         if progress is not None:
             progress(min(int(counters.step[0]), run.n_steps), run.n_steps)
         # Grow chunks towards about chunk_seconds each (the first includes compilation).
