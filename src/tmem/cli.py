@@ -148,9 +148,7 @@ def run(
     out: Path = typer.Option(..., "--out", "-o", help="Output directory; replaced only if it holds an earlier run."),
     checkpoint_every: float = typer.Option(
         None, "--checkpoint-every", metavar="SECONDS", show_default="none",
-        help="Save the run's whole state every SECONDS (s) of simulated time (not wall time; rounded to whole steps) "
-        "in .OUT.tmem-checkpoint.npz beside OUT. Killed, the same command run again goes on from the last one "
-        "and gives the same results; the file is removed once OUT is written.",
+        help="Save the whole state every SECONDS (s) of simulated time beside OUT; run again, a killed run resumes.",
     ),  # fmt: skip
 ) -> None:
     """Simulate SCENARIO and write summary.json, trajectory.nc and figures to OUT.
