@@ -119,12 +119,19 @@ class Command:
         return code, self.output.decode(errors="replace")
 
 
+def _progress(output: bytes) -> int:
+    """The latest percentage the progress bar showed in ``output``; 100 before it shows any (a loaded
+    machine may read the output late, so the first "%" alone does not say that the run still simulates)."""
+    shown = re.findall(rb"(\d+)%", output)
+    return int(shown[-1]) if shown else 100
+
+
 def moment(command: Command, when: str, writing) -> bool:
     """Wait for the moment ``when``; False if the command ended first."""
     if when == "start":
         return command.wait_for(lambda: time.monotonic() - command.started > 0.2)
-    if when == "simulating":
-        return command.wait_for(lambda: b"%" in command.output and not writing())
+    if when == "simulating":  # the progress bar's latest figure well short of the end: still simulating
+        return command.wait_for(lambda: _progress(command.output) < 90 and not writing())
     return command.wait_for(writing)
 
 
