@@ -201,7 +201,7 @@ def _mean_slope(k1, k2, k3, k4):
     )  # fmt: skip
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def substep(s, ux, uy, params):
     """One sub-step ``h``: the flight controller's commands, held, and one RK4 step of (Q1)-(Q4).
 
