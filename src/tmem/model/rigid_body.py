@@ -115,7 +115,7 @@ def rotation(qx, qy, qz, qw):
 
 
 @numba.njit(cache=True, inline="always")
-def wrench(s, frame):
+def wrench(s, r, frame):
     """Force and moment on the body, in the body frame, and the aerodynamic part of the force.
 
     Returns ``(f_x, f_y, f_z, m_x, m_y, m_z, a_x, a_y, a_z)``: ``F_b``, ``M_b`` and ``sum_k H_k + D``
@@ -125,9 +125,10 @@ def wrench(s, frame):
     ----------
     s : tuple of 17 float
         The body's state (module text).
+    r : tuple of 9 float
+        Its attitude's :func:`rotation`.
     frame : Airframe
     """
-    r = rotation(s[6], s[7], s[8], s[9])
     ub = r[0] * s[3] + r[3] * s[4] + r[6] * s[5]  # v_b = R^T v
     vb = r[1] * s[3] + r[4] * s[4] + r[7] * s[5]
     wb = r[2] * s[3] + r[5] * s[4] + r[8] * s[5]
@@ -165,16 +166,16 @@ def derivative(s, command, frame):
         The rotors' commanded speeds ``c_k`` (rad/s).
     frame : Airframe
     """
-    fx, fy, fz, mx, my, mz, _, _, _ = wrench(s, frame)
     r = rotation(s[6], s[7], s[8], s[9])
+    fx, fy, fz, mx, my, mz, _, _, _ = wrench(s, r, frame)
     qx, qy, qz, qw = s[6], s[7], s[8], s[9]
     wx, wy, wz = s[10], s[11], s[12]
-    inverse_tau = 1.0 / frame.tau_m
+    inverse_tau, inverse_mass = 1.0 / frame.tau_m, 1.0 / frame.mass
     return (
         s[3], s[4], s[5],
-        (r[0] * fx + r[1] * fy + r[2] * fz) / frame.mass,
-        (r[3] * fx + r[4] * fy + r[5] * fz) / frame.mass,
-        (r[6] * fx + r[7] * fy + r[8] * fz) / frame.mass - frame.g,
+        (r[0] * fx + r[1] * fy + r[2] * fz) * inverse_mass,
+        (r[3] * fx + r[4] * fy + r[5] * fz) * inverse_mass,
+        (r[6] * fx + r[7] * fy + r[8] * fz) * inverse_mass - frame.g,
         0.5 * (qw * wx - qz * wy + qy * wz),
         0.5 * (qz * wx + qw * wy - qx * wz),
         0.5 * (-qy * wx + qx * wy + qw * wz),
