@@ -72,3 +72,12 @@ def test_an_agent_added_back_starts_again_with_its_body():
     np.testing.assert_array_equal(trajectory.state[added, 1], trajectory.state[0, 1])
     removed = (trajectory.time > 3.0) & (trajectory.time < 5.0)
     assert np.all(trajectory.body[removed, 1] == trajectory.body[np.flatnonzero(removed)[0], 1])  # not stepped
+
+
+def test_the_continuous_reference_refuses_the_quadrotor_in_one_line():
+    from tmem.reference import integrate
+
+    with pytest.raises(ValueError, match=r"^model\.kind: .*body state") as refused:
+        integrate(from_dict({"model": {"kind": "quadrotor"}, "interaction": {"function": "repulsion"},
+                             "agents": [{"position": 50.0}, {"position": 0.0}]}))  # fmt: skip
+    assert "\n" not in str(refused.value)
