@@ -104,7 +104,7 @@ def axis_derivative(model: QuadrotorModel, axis: int, x: np.ndarray, u: float) -
     for _ in range(20):  # the rotors at their command: a fixed point (the feed-forward reads their drag)
         command = rate_loop(s, *flight_commands(s, *((u, 0.0) if axis == 0 else (0.0, u)), params), params)
         s = s[:13] + command
-    slope = np.array(derivative(s, command, params.frame))
+    slope = np.array(derivative(s, command, params))
     eps = 1e-6
 
     def view(t):  # (P, V, phi, omega) on the axis

@@ -81,3 +81,20 @@ def test_the_continuous_reference_refuses_the_quadrotor_in_one_line():
         integrate(from_dict({"model": {"kind": "quadrotor"}, "interaction": {"function": "repulsion"},
                              "agents": [{"position": 50.0}, {"position": 0.0}]}))  # fmt: skip
     assert "\n" not in str(refused.value)
+
+
+def test_the_quadrotor_swarm_on_threads_is_the_serial_one(monkeypatch):
+    from tmem.engine import driver
+
+    gas = from_dict({
+        "model": {"kind": "quadrotor"}, "interaction": {"function": "repulsion"},
+        "space": {"axes": 2, "periodic": True, "box": [200.0, 200.0]},
+        "swarm": {"n": 40, "seed": 3, "speed_rms": 3.0}, "neighbors": {"method": "verlet"},
+        "simulation": {"dt": 0.01, "duration": 2.0, "record_every": 20},
+    })  # fmt: skip
+    serial = tmem.simulate(gas)
+    monkeypatch.setattr(driver, "THREADED_SWARM", 0)
+    threaded = tmem.simulate(gas)
+    np.testing.assert_array_equal(threaded.state, serial.state)
+    np.testing.assert_array_equal(threaded.body, serial.body)
+    assert np.ptp(serial.body[:, :, BODY_NAMES.index("rotor_1")]) > 0.0  # the rotors worked

@@ -76,32 +76,16 @@ BODY_LONG_NAMES = (
 )  # fmt: skip
 
 
-class QuadrotorStep(NamedTuple):
-    """What one step of ``dt`` needs: the airframe, the inner loop's gains and the sub-steps.
-
-    Attributes
-    ----------
-    frame : Airframe
-    kp, kd : float
-        Attitude (Q5) and rate (Q6) loop gains (1/s).
-    altitude_kp, altitude_kd : float
-        The altitude hold's gains (Q7) (1/s^2, 1/s).
-    feedforward : bool
-        Whether the drag feed-forward (Q8) is on.
-    substeps : int
-        Sub-steps in ``dt``.
-    h : float
-        The sub-step (s).
-    """
-
-    frame: Airframe
-    kp: float
-    kd: float
-    altitude_kp: float
-    altitude_kd: float
-    feedforward: bool
-    substeps: int
-    h: float
+#: What one step of ``dt`` needs: the airframe's numbers (:class:`~tmem.model.rigid_body.Airframe`'s
+#: fields, so that the record serves as the airframe), then the inner loop's gains ``kp``, ``kd``
+#: (Q5)-(Q6) (1/s) and ``altitude_kp``, ``altitude_kd`` (Q7) (1/s^2, 1/s), whether the drag
+#: feed-forward (Q8) is on, the number of sub-steps in ``dt`` and the sub-step ``h`` (s).  One flat
+#: record: a parallel loop takes no record nested in another.
+QuadrotorStep = NamedTuple(
+    "QuadrotorStep",
+    [*Airframe.__annotations__.items(), ("kp", float), ("kd", float), ("altitude_kp", float), ("altitude_kd", float),
+     ("feedforward", bool), ("substeps", int), ("h", float)],
+)  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")
@@ -138,7 +122,7 @@ def flight_commands(s, ux, uy, params):
         Tilt set-points ``U`` on x and y (rad).
     params : QuadrotorStep
     """
-    frame = params.frame
+    frame = params
     r = rotation(s[6], s[7], s[8], s[9])
     if params.feedforward:
         _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame)
@@ -167,7 +151,7 @@ def rate_loop(s, thrust, rate_x, rate_y, rate_z, params):
         Body-rate set-points (rad/s).
     params : QuadrotorStep
     """
-    frame, kd = params.frame, params.kd
+    frame, kd = params, params.kd
     mx = frame.ixx * kd * (rate_x - s[10])
     my = frame.iyy * kd * (rate_y - s[11])
     mz = frame.izz * kd * (rate_z - s[12])
@@ -217,7 +201,7 @@ def substep(s, ux, uy, params):
         Tilt set-points ``U`` on x and y (rad).
     params : QuadrotorStep
     """
-    frame, h = params.frame, params.h
+    frame, h = params, params.h
     thrust, rate_x, rate_y, rate_z = flight_commands(s, ux, uy, params)
     command = rate_loop(s, thrust, rate_x, rate_y, rate_z, params)
     k1 = derivative(s, command, frame)
@@ -352,7 +336,7 @@ class QuadrotorModel(VehicleModel):
         """
         p = self.params
         substeps = max(1, math.ceil(dt / p.inner_period - 1e-9))
-        return QuadrotorStep(self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward,
+        return QuadrotorStep(*self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward,
                              substeps, dt / substeps)  # fmt: skip
 
     def initial_body(self, state: np.ndarray) -> np.ndarray:

@@ -49,6 +49,9 @@ ROTOR_SENSE = (1.0, -1.0, 1.0, -1.0)
 class Airframe(NamedTuple):
     """The numbers of the rigid body and its rotors (SI units; :mod:`tmem.model.quadrotor` fills them).
 
+    The compiled functions read these fields by name from whatever record they are given: the
+    quadrotor's step record has them all, and serves as the airframe.
+
     Attributes
     ----------
     mass, g : float
