@@ -18,6 +18,11 @@ def edit(old: str, new: str) -> str:
     return GOOD.replace(old, new, 1)
 
 
+def quadrotor(keys: str) -> str:
+    """The good scenario on the quadrotor, with ``keys`` (TOML lines) in its ``[model]`` table."""
+    return edit('[model]\nkind = "linear"\nkp = 6.0\nkd = 25.0\ng = 9.8', f'[model]\nkind = "quadrotor"\n{keys}')
+
+
 def without_agent(text: str) -> str:
     head, _, tail = text.partition("[[agents]]")
     return head + tail.split("[[agents]]", 1)[1].join(["[[agents]]", ""]) if tail else text
@@ -59,11 +64,17 @@ CASES = {
     "bearing on one axis": (GOOD + '\n[formation]\nkind = "edges"\nedges = [[0, 1]]\nbearing = true\n',
                             "formation.bearing", "2 or 3 axes"),
     "table as a number": (GOOD.replace('[model]\nkind = "linear"\nkp = 6.0\nkd = 25.0\ng = 9.8', "model = 3"), "model", "must be a table"),
-    "unknown model kind": (edit('kind = "linear"', 'kind = "nonsense"'), "model.kind", "must be 'linear', got 'nonsense'"),
-    "model kind not a name": (edit('kind = "linear"', "kind = 2"), "model.kind", "must be 'linear', got 2"),
+    "unknown model kind": (edit('kind = "linear"', 'kind = "nonsense"'), "model.kind", "must be one of 'linear', 'quadrotor', got 'nonsense'"),
+    "model kind not a name": (edit('kind = "linear"', "kind = 2"), "model.kind", "must be one of 'linear', 'quadrotor', got 2"),
     "typo in a model key": (edit("kd = 25.0", "kdd = 25.0"), "model.kdd", "unknown key"),
     "wrong type": (edit("kd = 25.0", 'kd = "fast"'), "model.kd", "number"),
     "toml syntax": (edit("kd = 25.0", "kd = = 25.0"), "TOML syntax error", "line 6"),
+    "quadrotor in 3-D": (quadrotor("").replace("axes = 1", "axes = 3").replace("position = 50.0", "position = [50.0, 0.0, 0.0]").replace("position = 0.0", "position = [0.0, 0.0, 0.0]").replace("velocity = -1.5", "velocity = [-1.5, 0.0, 0.0]").replace("velocity = 3.0", "velocity = [3.0, 0.0, 0.0]"),
+                         "space.axes", "at most 2 axes"),
+    "quadrotor cannot lift": (quadrotor("rotor_speed_max = 1800.0"), "model.rotor_speed_max", "hover speed"),
+    "quadrotor inner loop too slow": (quadrotor("inner_period = 0.05"), "model.inner_period", "too long for the rate loop"),
+    "quadrotor drag negative": (quadrotor("rotor_drag = -1.0"), "model.rotor_drag", "greater than or equal to 0"),
+    "quadrotor typo": (quadrotor("mas = 0.03"), "model.mas", "unknown key"),
 }
 
 

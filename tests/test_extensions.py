@@ -77,7 +77,7 @@ EXTENSIONS = {
 
 
             def _linear_unless_named''')),
-        ("scenario/tables.py", "Union[LinearModelParams]", "Union[LinearModelParams, DragModelParams]"),
+        ("scenario/tables.py", "LinearModelParams | QuadrotorModelParams,", "LinearModelParams | QuadrotorModelParams | DragModelParams,"),
     ],
     "sensing effect": [
         ("sensing.py", 'EFFECTS = ("identity",)', 'EFFECTS = ("identity", "quantised")'),

@@ -146,7 +146,7 @@ def _case_step(k, e, x, agents, pairs, law, params, box, hold, command_step, n_s
     formation_pair(k, e, x, agents, pairs, law, params, box, events, counters)
     if k < n_steps:
         for s in (i, j):
-            step_zero_order_hold(x, agents.setpoint, s, tilt_scale(agents.setpoint, s, n_axes, params.c_max), hold, n_axes)
+            step_zero_order_hold(x, agents.body, agents.setpoint, s, tilt_scale(agents.setpoint, s, n_axes, params.c_max), hold, n_axes)
     return k + 1
 
 
@@ -173,7 +173,9 @@ def _run_block(first, lanes, starts, n_steps, dt, command_step, hold, law, param
     x = np.zeros((2 * lanes, n_axes, 4))
     for c in range(lanes):
         x[2 * c : 2 * c + 2] = starts[first + c]
-    agents = Agents(x, x, np.ones(2 * lanes, dtype=np.bool_), np.zeros((2 * lanes, n_axes, 2)), np.zeros((2 * lanes, n_axes)))
+    no_body = np.zeros((2 * lanes, 0))  # the linear model has no body state
+    agents = Agents(x, x, np.ones(2 * lanes, dtype=np.bool_), np.zeros((2 * lanes, n_axes, 2)), np.zeros((2 * lanes, n_axes)),
+                    no_body, no_body)
     nan = np.full(lanes, np.nan)
     pairs = Pairs(np.arange(0, 2 * lanes, 2), np.arange(1, 2 * lanes, 2), np.full(lanes, params.d_t),
                   np.full((lanes, n_axes), np.nan), np.zeros(lanes, dtype=np.int64), np.ones(lanes, dtype=np.int64),

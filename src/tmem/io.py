@@ -47,7 +47,9 @@ def contents(trajectory: Trajectory) -> Contents:
 
     Dimensions ``time``, ``agent`` (the recorded agents, by index), ``axis``
     and ``pair``; variables ``P``, ``V``, ``phi``, ``omega`` (the vehicle
-    model's state names) and the control ``U`` over (time, agent, axis);
+    model's state names) and the control ``U`` over (time, agent, axis); the
+    model's body state, when it has one, over (time, agent), a variable per
+    component (the quadrotor's ``height``, ``q_w``, ``rotor_1``, ...);
     ``active`` over (time, agent); the coupling flag ``F_en``, the distance and
     the interaction distance ``|d|`` (6) over (time, pair); each pair's set
     distance ``d_t``; the RMS velocity of the recorded agents over time; when
@@ -76,6 +78,9 @@ def contents(trajectory: Trajectory) -> Contents:
     model = trajectory.model
     for m, (name, long_name, units) in enumerate(zip(model.state_names, model.long_names, model.state_units)):
         data[name] = (over_agents, trajectory.state[..., m], {"long_name": long_name, "units": units})
+    if trajectory.body.shape[-1]:
+        for m, (name, long_name, units) in enumerate(zip(model.body_names, model.body_long_names, model.body_units)):
+            data[name] = (("time", "agent"), trajectory.body[..., m], {"long_name": long_name, "units": units})
     data["U"] = (over_agents, trajectory.control, {"long_name": "tilt set-point (control)", "units": "rad"})
     data["active"] = (("time", "agent"), trajectory.active.astype(np.int8), {"long_name": "agent flying", "units": "1"})
     data["F_en"] = (over_pairs, trajectory.flag.astype(np.int8), {"long_name": "pair coupling flag F_en", "units": "1"})

@@ -157,6 +157,11 @@ def _check(scenario: Scenario, model: VehicleModel) -> None:
     n_axes = scenario.space.axes
     if n_axes != 1:
         raise ValueError(f"space.axes: the continuous reference supports one axis only, got {n_axes}")
+    if model.body_names:
+        raise ValueError(
+            f"model.kind: the continuous reference integrates the linearisation, which is not the "
+            f"whole of {model.kind!r}: its body state {tuple(model.body_names)} has no place in it"
+        )
     names = tuple(model.state_names)
     if len(names) != 4:
         raise ValueError(

@@ -170,7 +170,7 @@ class _NeighbourLister:
 
 
 def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int,
-             observe: bool) -> Records:
+             observe: bool, n_body: int) -> Records:
     rows = n_steps_recorded
     return Records(
         slots=slots,
@@ -181,6 +181,7 @@ def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n
         distance=np.empty((rows, n_edges)),
         measure=np.empty((rows, n_edges)),
         gas=np.zeros((rows, len(TOTALS) + len(SNAPSHOT) if observe else 0)),
+        body=np.empty((rows, len(rec_agents), n_body)),
     )
 
 
@@ -216,8 +217,9 @@ class _Slots:
     steps: np.ndarray  # the recorded steps
 
 
-def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, record: bool) -> _Slots:
-    """The records of a run, its agents placed in a spatial order of their ``P*`` (6)."""
+def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, record: bool, body: np.ndarray) -> _Slots:
+    """The records of a run, its agents placed in a spatial order of their ``P*`` (6); ``body`` the
+    agents' body states at the start (by agent number)."""
     sim = scenario.simulation
     n_agents, n_axes, n_state = initial.state.shape
     cell = scenario.interaction.reach + scenario.neighbors.skin
@@ -225,7 +227,9 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     slot = np.empty(n_agents, dtype=np.int64)
     slot[order] = np.arange(n_agents)
     x = initial.state[order]
-    agents = Agents(x, x.copy(), initial.active[order], np.empty((n_agents, n_axes, 2)), np.zeros((n_agents, n_axes)))
+    body = body[order]
+    agents = Agents(x, x.copy(), initial.active[order], np.empty((n_agents, n_axes, 2)), np.zeros((n_agents, n_axes)),
+                    body, body.copy())
     edges = initial.edges
     n_edges = len(edges)
     pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
@@ -237,7 +241,7 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
     recorded = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)
     recorded = recorded if record else recorded[:0]
-    records = _records(len(steps), recorded, slot[recorded], n_axes, n_state, n_edges, scenario.gas_observed)
+    records = _records(len(steps), recorded, slot[recorded], n_axes, n_state, n_edges, scenario.gas_observed, body.shape[1])
     # A pair changes flag at most once before any command and twice after each.
     events = _events(n_edges * (1 + 2 * len(commands.step)) + len(commands.step))
     return _Slots(order, slot, agents, pairs, commands, records, events, Counters.zero(), recorded, steps)
@@ -288,7 +292,7 @@ def simulate(
     initial = build(scenario)
     run = _run_of(scenario, initial, record)
     law, params = law_of(scenario, model.linearisation(), gains)
-    swarm = _in_slots(scenario, initial, gains, record)
+    swarm = _in_slots(scenario, initial, gains, record, model.initial_body(initial.state))
     x = swarm.agents.state
     lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], np.stack([swarm.pairs.i, swarm.pairs.j], axis=1), run.use_lists)
     lister.p_ref[:] = interaction_point(x, gains)  # P* (6) at the start
@@ -319,6 +323,8 @@ def simulate(
         events=_read_events(swarm.events, int(swarm.counters.n_events[0]), swarm.order, sim.dt),
         list_builds=lister.builds,
         gas=swarm.records.gas,
+        body=swarm.records.body,
+        final_body=swarm.agents.body[swarm.slot],
     )
 
 

@@ -36,12 +36,12 @@ from .pairs import formation_pairs
 from .stages import apply_commands, commands_due, corrected_positions, is_recorded, neighbour_pushes, record
 
 
-def vehicle_step(x, u, i, scale, params, n_axes):
+def vehicle_step(x, body, u, i, scale, params, n_axes):
     """Placeholder for the vehicle model's compiled step, bound by :func:`advance_for`.
 
     Parameters
     ----------
-    x, u, i, scale, params, n_axes
+    x, body, u, i, scale, params, n_axes
         As :attr:`tmem.model.base.VehicleModel.step` takes them.
     """
     raise NotImplementedError("the step loop is compiled by advance_for, which binds the vehicle model's step")
@@ -61,6 +61,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     c_max = params.c_max
     x = agents.state
     u = agents.setpoint
+    body = agents.body
     active = agents.active
     observe = gas.observe
     work, kept, totals = gas.work, gas.kept, gas.totals  # parallel loops take arrays, not records
@@ -85,7 +86,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
             for i in numba.prange(x.shape[0]):
                 if active[i]:
                     scale = tilt_scale(u, i, n_axes, tilt_limit(observe, kept, i, c_max))
-                    vehicle_step(x, u, i, scale, vehicle, n_axes)
+                    vehicle_step(x, body, u, i, scale, vehicle, n_axes)
                     for a in range(n_axes):
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
                             x[i, a, 0] = into_box(x[i, a, 0], box[a])

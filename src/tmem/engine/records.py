@@ -106,6 +106,11 @@ class Agents(NamedTuple):
         ``(P*, P)`` on each axis, as the agent's neighbours measure it.
     setpoint : ndarray, shape (agents, axes)
         The sum of pushes ``U`` of this step, before saturation.
+    body : ndarray, shape (agents, n_body)
+        The vehicle model's body state (:attr:`tmem.model.base.VehicleModel.body_names`; no
+        columns for the linear model).
+    body_start : ndarray, shape (agents, n_body)
+        The body state an added agent starts with.
     """
 
     state: np.ndarray
@@ -113,6 +118,8 @@ class Agents(NamedTuple):
     active: np.ndarray
     corrected: np.ndarray
     setpoint: np.ndarray
+    body: np.ndarray
+    body_start: np.ndarray
 
 
 class Pairs(NamedTuple):
@@ -214,7 +221,8 @@ class Commands(NamedTuple):
 
 class Records(NamedTuple):
     """What is recorded at each recorded step, for the agents in ``slots`` and every pair; ``gas``
-    the swarm's totals (:data:`tmem.engine.gas.TOTALS`, no columns when the gas is not observed)."""
+    the swarm's totals (:data:`tmem.engine.gas.TOTALS`, no columns when the gas is not observed);
+    ``body`` the recorded agents' body states (no columns for a model without one)."""
 
     slots: np.ndarray
     state: np.ndarray
@@ -224,6 +232,7 @@ class Records(NamedTuple):
     distance: np.ndarray
     measure: np.ndarray
     gas: np.ndarray
+    body: np.ndarray
 
 
 class Gas(NamedTuple):

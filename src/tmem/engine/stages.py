@@ -111,6 +111,8 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
                 for a in range(agents.state.shape[1]):
                     for m in range(agents.state.shape[2]):
                         agents.state[i, a, m] = agents.start[i, a, m]
+                for m in range(agents.body.shape[1]):
+                    agents.body[i, m] = agents.body_start[i, m]
             else:
                 agents.state[i, :, 1:] = 0.0
             log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind, -1)
@@ -341,6 +343,8 @@ def record(agents, pairs, records, c_max, run, counters, gas):
         for a in range(n_axes):
             for m in range(agents.state.shape[2]):
                 records.state[q_record, q, a, m] = agents.state[i, a, m]
+        for m in range(agents.body.shape[1]):
+            records.body[q_record, q, m] = agents.body[i, m]
         records.active[q_record, q] = agents.active[i]
         scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas.observe, gas.kept, i, c_max)) if agents.active[i] else 0.0
         for a in range(n_axes):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -75,6 +75,11 @@ class Trajectory:
         When the gas is observed (:attr:`Scenario.gas_observed`), at each record the swarm's running
         totals :data:`tmem.engine.gas.TOTALS` and then :data:`tmem.engine.gas.SNAPSHOT`
         (:mod:`tmem.observables` reads them); no columns otherwise.
+    body : ndarray, shape (n_records, n_recorded, n_body)
+        The vehicle model's body state at each recorded time, named by ``model.body_names``
+        (no columns for the linear model).
+    final_body : ndarray, shape (agents, n_body)
+        Every agent's body state at the end.
     """
 
     scenario: Scenario
@@ -96,6 +101,8 @@ class Trajectory:
     events: list[Event]
     list_builds: int
     gas: np.ndarray
+    body: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 0)))
+    final_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
     def pairs(self) -> np.ndarray:

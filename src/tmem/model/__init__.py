@@ -15,6 +15,7 @@ from typing import Any
 #: ``kind -> "module:Class"`` of each vehicle model.
 MODELS: dict[str, str] = {
     "linear": "tmem.model.linear:LinearModel",
+    "quadrotor": "tmem.model.quadrotor:QuadrotorModel",
 }
 
 

@@ -5,7 +5,11 @@ per horizontal axis ``a`` as ``state[i, a, :]``; a model names the components
 and their units.  The TMEM law reads the first four, in the order of the
 paper's model (2): position ``P`` (m), velocity ``V`` (m/s), tilt ``phi``
 (rad) and tilt rate ``omega`` (rad/s); a model may keep more components
-after them (a motor's state, say).
+after them (a motor's state, say).  What belongs to the whole vehicle rather
+than to one axis (a quadrotor's height, attitude, body rates and rotor
+speeds) is its *body state* ``body[i, :]``, named by :attr:`VehicleModel.body_names`:
+the engine carries it beside the per-axis state, restores it with the state
+when an agent is added back, and records it.  The linear model has none.
 
 A model provides
 
@@ -13,10 +17,12 @@ A model provides
 * its linearisation ``(A, B)`` about hover, per axis, on ``(P, V, phi, omega)``
   with the tilt set-point as input: the modal gains (4) are designed on it
   (:func:`tmem.control.gains_for`);
+* its body state at the start, from the per-axis one (:meth:`VehicleModel.initial_body`);
 * its compiled step: :meth:`VehicleModel.step_params` gives the record of
   numbers the step needs for a time step ``dt``, and :attr:`VehicleModel.step`
-  is a Numba kernel ``step(x, u, i, scale, params, n_axes)`` that advances
-  agent ``i`` over ``dt`` in place with the set-point ``u[i, :] * scale`` held.
+  is a Numba kernel ``step(x, body, u, i, scale, params, n_axes)`` that advances
+  agent ``i`` (its ``x[i]`` and ``body[i]``) over ``dt`` in place with the
+  set-point ``u[i, :] * scale`` held.
   A linear model can step exactly (zero-order hold); a nonlinear one takes
   sub-steps of its own within ``dt``.
 
@@ -49,7 +55,11 @@ class VehicleModel(ABC):
     state_units: ClassVar[tuple[str, ...]]
     #: A longer name of each component, for files and figures.
     long_names: ClassVar[tuple[str, ...]]
-    #: The compiled step ``step(x, u, i, scale, params, n_axes)``: see the module text.
+    #: Names, units and longer names of the body state's components (none for a model without one).
+    body_names: ClassVar[tuple[str, ...]] = ()
+    body_units: ClassVar[tuple[str, ...]] = ()
+    body_long_names: ClassVar[tuple[str, ...]] = ()
+    #: The compiled step ``step(x, body, u, i, scale, params, n_axes)``: see the module text.
     step: ClassVar[Any]
 
     #: Indices of position, velocity and tilt in the per-axis state.
@@ -73,6 +83,15 @@ class VehicleModel(ABC):
         dt : float
             The time step (s).
         """
+
+    def initial_body(self, state: np.ndarray) -> np.ndarray:
+        """The body states of agents starting in the per-axis states ``state``: shape ``(agents, len(body_names))``.
+
+        Parameters
+        ----------
+        state : ndarray, shape (agents, axes, n_state)
+        """
+        return np.zeros((state.shape[0], len(self.body_names)))
 
     def position(self, state: np.ndarray) -> np.ndarray:
         """Positions (m) from states shaped ``(..., axes, n_state)``: shape ``(..., axes)``.

@@ -116,13 +116,15 @@ def hold_step(ad, bd, x0, x1, x2, x3, u):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def step_zero_order_hold(x, u, i, scale, params, n_axes):
+def step_zero_order_hold(x, body, u, i, scale, params, n_axes):
     """Advance agent ``i`` of ``x`` (agents, axes, 4) over one step with ``U = u[i] * scale`` held (2).
 
     Parameters
     ----------
     x : ndarray, shape (agents, axes, 4)
         States, changed in place.
+    body : ndarray, shape (agents, 0)
+        The body states: the linear model has none.
     u : ndarray, shape (agents, axes)
         Summed tilt set-points (rad).
     i : int

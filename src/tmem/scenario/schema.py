@@ -179,6 +179,10 @@ class Scenario(StrictModel):
         if n < 2:
             raise FieldError("agents", f"needs at least 2 agents, got {n}")
         self._check_space()
+        max_axes = getattr(self.model, "max_axes", 3)  # a [model] table may say how many axes its model flies
+        if axes > max_axes:
+            raise FieldError("space.axes", f"the {self.model.kind} model flies runs of at most {max_axes} axes, "
+                             f"got {axes}: its vertical axis is held by the altitude hold, not steered by the TMEM law")  # fmt: skip
         self._check_obstacles(axes)
         self._check_coverage()
         self._check_sampling()

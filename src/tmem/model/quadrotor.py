@@ -1,0 +1,365 @@
+"""A nonlinear quadrotor flown by the TMEM law: the rigid body of :mod:`tmem.model.rigid_body` and its inner loop.
+
+The TMEM law gives each horizontal axis ``a`` its tilt set-point ``U_a``.  The
+tilt on axis ``a`` is the angle of the thrust axis ``b_3 = R e_3`` from the
+vertical, seen along the other horizontal axis, ``phi_a = atan2(b_3a, b_3z)``.
+The vehicle's flight controller runs every sub-step ``h`` (zero-order hold, as
+a digital one does) and turns the set-points into what the vehicle takes:
+
+* attitude loop, the paper's (1)::
+
+      omega_d = kp (phi_d - phi)                                   (Q5)
+
+  on each axis, as body rates: ``w_y,d = kp (phi_d,x - phi_x)``,
+  ``w_x,d = -kp (phi_d,y - phi_y)`` (a tilt along +x is a rotation about +y,
+  along +y about -x), and the yaw held at 0 with ``w_z,d = -kp psi``;
+* rate loop, the paper's ``omega' = kd (omega_d - omega)`` on the body rates,
+  realised as moments through the rotors and their lag (RotorPy's ``cmd_ctbr``
+  with ``k_w = kd``)::
+
+      M = J kd (w_d - w)                                           (Q6)
+
+* altitude hold: a collective thrust whose vertical part carries the weight
+  and a PD correction of the height ``z`` (0 at the start)::
+
+      T = m (g - k_zp z - k_zd z') / b_3z                           (Q7)
+
+  so that, height held, the horizontal acceleration on each axis is
+  ``g tan(phi_a)``: with this tilt and ``T b_3z = m g`` it is exactly
+  ``(T / m) b_3a = g b_3a / b_3z``, on each axis apart, and to first order it
+  is (2)'s ``g phi``.  (Holding the thrust at ``m g`` instead would give
+  ``g sin``, and the vehicle would sink as it tilts.)
+* drag feed-forward (``drag_feedforward``): the frame's and rotors' drag
+  slows a quadrotor in free flight (the Crazyflie's rotor drag alone, by
+  ``c_h = 4 k_d o_h / m = 0.24 /s``), where (2)'s agent keeps its speed.  The
+  controller adds the tilt that balances the drag it would feel now,
+  ``phi_ff,a = atan(-D_a / (m g))`` with ``D_a`` the aerodynamic force on axis
+  ``a`` (world frame), to the set-point::
+
+      phi_d = U + phi_ff                                           (Q8)
+
+The sub-step ``h`` is the longest that divides ``dt`` into whole steps and is
+at most ``inner_period``; RK4 integrates (Q1)-(Q4) over each sub-step, and the
+quaternion is normalised after it, as RotorPy does after each of its steps.
+
+State layout.  The engine keeps each axis's ``(P, V, phi, omega)`` (the TMEM
+law reads them) in ``state[i, a, :]`` and the rest of the body in the
+per-agent body state ``body[i, :]`` (:data:`BODY_NAMES`).  ``P`` and ``V`` are
+the body's own horizontal position and velocity; ``phi`` and ``omega`` are
+written from its attitude and body rates after each step.  A 1-D run flies in
+the vertical x-z plane: the lateral position and velocity are zero by
+symmetry, and not kept.  A 3-D run is refused: the vertical axis is the
+altitude hold's.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from .base import VehicleModel
+from .linear import STATE_NAMES
+from .rigid_body import Airframe, derivative, hover_speed, rotation, rotor_commands, wrench
+
+#: The per-agent body state, after the per-axis ``(P, V, phi, omega)``.
+BODY_NAMES = ("height", "v_z", "q_x", "q_y", "q_z", "q_w", "w_x", "w_y", "w_z", "rotor_1", "rotor_2", "rotor_3", "rotor_4")
+BODY_UNITS = ("m", "m s-1", "1", "1", "1", "1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1")
+BODY_LONG_NAMES = (
+    "height above the start", "vertical velocity",
+    "attitude quaternion x", "attitude quaternion y", "attitude quaternion z", "attitude quaternion w",
+    "body rate about x", "body rate about y", "body rate about z",
+    "speed of rotor 1", "speed of rotor 2", "speed of rotor 3", "speed of rotor 4",
+)  # fmt: skip
+
+
+#: What one step of ``dt`` needs: the airframe's numbers (:class:`~tmem.model.rigid_body.Airframe`'s
+#: fields, so that the record serves as the airframe), then the inner loop's gains ``kp``, ``kd``
+#: (Q5)-(Q6) (1/s) and ``altitude_kp``, ``altitude_kd`` (Q7) (1/s^2, 1/s), whether the drag
+#: feed-forward (Q8) is on, the number of sub-steps in ``dt`` and the sub-step ``h`` (s).  One flat
+#: record: a parallel loop takes no record nested in another.
+QuadrotorStep = NamedTuple(
+    "QuadrotorStep",
+    [*Airframe.__annotations__.items(), ("kp", float), ("kd", float), ("altitude_kp", float), ("altitude_kd", float),
+     ("feedforward", bool), ("substeps", int), ("h", float)],
+)  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def axis_view(s):
+    """``(phi_x, omega_x, phi_y, omega_y)``: each axis's tilt and its rate of change, from the body's state.
+
+    ``phi_a = atan2(b_3a, b_3z)`` and ``omega_a = (b_3z b_3a' - b_3a b_3z') / (b_3a^2 + b_3z^2)``,
+    with ``b_3' = w_y b_1 - w_x b_2`` (the columns of ``R``).
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state (:mod:`tmem.model.rigid_body`).
+    """
+    r = rotation(s[6], s[7], s[8], s[9])
+    wx, wy = s[10], s[11]
+    b3x, b3y, b3z = r[2], r[5], r[8]
+    dx, dy, dz = wy * r[0] - wx * r[1], wy * r[3] - wx * r[4], wy * r[6] - wx * r[7]
+    return (
+        math.atan2(b3x, b3z), (b3z * dx - b3x * dz) / (b3x * b3x + b3z * b3z),
+        math.atan2(b3y, b3z), (b3z * dy - b3y * dz) / (b3y * b3y + b3z * b3z),
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def flight_commands(s, ux, uy, params):
+    """Collective thrust and body-rate set-points ``(T, w_x,d, w_y,d, w_z,d)``, (Q5), (Q7) and (Q8).
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state.
+    ux, uy : float
+        Tilt set-points ``U`` on x and y (rad).
+    params : QuadrotorStep
+    """
+    frame = params
+    r = rotation(s[6], s[7], s[8], s[9])
+    if params.feedforward:
+        _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame)
+        weight = frame.mass * frame.g
+        ux += math.atan(-(r[0] * ax + r[1] * ay + r[2] * az) / weight)
+        uy += math.atan(-(r[3] * ax + r[4] * ay + r[5] * az) / weight)
+    b3z = r[8]
+    thrust = frame.mass * (frame.g - params.altitude_kp * s[2] - params.altitude_kd * s[5]) / b3z
+    rate_x = -params.kp * (uy - math.atan2(r[5], b3z))
+    rate_y = params.kp * (ux - math.atan2(r[2], b3z))
+    rate_z = -params.kp * math.atan2(r[3], r[0])
+    return thrust, rate_x, rate_y, rate_z
+
+
+@numba.njit(cache=True, inline="always")
+def rate_loop(s, thrust, rate_x, rate_y, rate_z, params):
+    """The rotor speeds commanded for the thrust and the body rates asked for: (Q6), then the allocation.
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state.
+    thrust : float
+        Collective thrust (N).
+    rate_x, rate_y, rate_z : float
+        Body-rate set-points (rad/s).
+    params : QuadrotorStep
+    """
+    frame, kd = params, params.kd
+    mx = frame.ixx * kd * (rate_x - s[10])
+    my = frame.iyy * kd * (rate_y - s[11])
+    mz = frame.izz * kd * (rate_z - s[12])
+    return rotor_commands(thrust, mx, my, mz, frame)
+
+
+@numba.njit(cache=True, inline="always")
+def _plus(s, k, c):
+    """``s + c k`` for two body states."""
+    return (
+        s[0] + c * k[0], s[1] + c * k[1], s[2] + c * k[2], s[3] + c * k[3], s[4] + c * k[4], s[5] + c * k[5],
+        s[6] + c * k[6], s[7] + c * k[7], s[8] + c * k[8], s[9] + c * k[9], s[10] + c * k[10],
+        s[11] + c * k[11], s[12] + c * k[12], s[13] + c * k[13], s[14] + c * k[14], s[15] + c * k[15],
+        s[16] + c * k[16],
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def _mean_slope(k1, k2, k3, k4):
+    """RK4's weighted mean of the four slopes, ``(k1 + 2 k2 + 2 k3 + k4) / 6``."""
+    return (
+        (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]) / 6.0, (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]) / 6.0,
+        (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]) / 6.0, (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3]) / 6.0,
+        (k1[4] + 2.0 * (k2[4] + k3[4]) + k4[4]) / 6.0, (k1[5] + 2.0 * (k2[5] + k3[5]) + k4[5]) / 6.0,
+        (k1[6] + 2.0 * (k2[6] + k3[6]) + k4[6]) / 6.0, (k1[7] + 2.0 * (k2[7] + k3[7]) + k4[7]) / 6.0,
+        (k1[8] + 2.0 * (k2[8] + k3[8]) + k4[8]) / 6.0, (k1[9] + 2.0 * (k2[9] + k3[9]) + k4[9]) / 6.0,
+        (k1[10] + 2.0 * (k2[10] + k3[10]) + k4[10]) / 6.0, (k1[11] + 2.0 * (k2[11] + k3[11]) + k4[11]) / 6.0,
+        (k1[12] + 2.0 * (k2[12] + k3[12]) + k4[12]) / 6.0, (k1[13] + 2.0 * (k2[13] + k3[13]) + k4[13]) / 6.0,
+        (k1[14] + 2.0 * (k2[14] + k3[14]) + k4[14]) / 6.0, (k1[15] + 2.0 * (k2[15] + k3[15]) + k4[15]) / 6.0,
+        (k1[16] + 2.0 * (k2[16] + k3[16]) + k4[16]) / 6.0,
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, error_model="numpy")
+def substep(s, ux, uy, params):
+    """One sub-step ``h``: the flight controller's commands, held, and one RK4 step of (Q1)-(Q4).
+
+    Returns the body's state after it, its quaternion normalised.  It is called, not inlined: the
+    step loop compiles in the same time as the linear model's, and a call per sub-step costs
+    little beside its four evaluations of (Q1)-(Q4).
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state.
+    ux, uy : float
+        Tilt set-points ``U`` on x and y (rad).
+    params : QuadrotorStep
+    """
+    frame, h = params, params.h
+    thrust, rate_x, rate_y, rate_z = flight_commands(s, ux, uy, params)
+    command = rate_loop(s, thrust, rate_x, rate_y, rate_z, params)
+    k1 = derivative(s, command, frame)
+    k2 = derivative(_plus(s, k1, 0.5 * h), command, frame)
+    k3 = derivative(_plus(s, k2, 0.5 * h), command, frame)
+    k4 = derivative(_plus(s, k3, h), command, frame)
+    s = _plus(s, _mean_slope(k1, k2, k3, k4), h)
+    n = 1.0 / math.sqrt(s[6] * s[6] + s[7] * s[7] + s[8] * s[8] + s[9] * s[9])
+    return (s[0], s[1], s[2], s[3], s[4], s[5], s[6] * n, s[7] * n, s[8] * n, s[9] * n,
+            s[10], s[11], s[12], s[13], s[14], s[15], s[16])  # fmt: skip
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def step_quadrotor(x, body, u, i, scale, params, n_axes):
+    """Advance agent ``i`` over one step with the tilt set-points ``U = u[i] * scale`` held.
+
+    Parameters
+    ----------
+    x : ndarray, shape (agents, axes, 4)
+        Per-axis states ``(P, V, phi, omega)``, changed in place.
+    body : ndarray, shape (agents, 13)
+        Body states (:data:`BODY_NAMES`), changed in place.
+    u : ndarray, shape (agents, axes)
+        Summed tilt set-points (rad).
+    i : int
+        The agent.
+    scale : float
+        Saturation factor of ``u[i]`` (:func:`tmem.control.tilt_scale`).
+    params : QuadrotorStep
+    n_axes : int
+        Number of axes, 1 or 2.
+    """
+    two = n_axes > 1
+    ux = u[i, 0] * scale
+    uy = u[i, 1] * scale if two else 0.0
+    b = body
+    s = (x[i, 0, 0], x[i, 1, 0] if two else 0.0, b[i, 0], x[i, 0, 1], x[i, 1, 1] if two else 0.0, b[i, 1],
+         b[i, 2], b[i, 3], b[i, 4], b[i, 5], b[i, 6], b[i, 7], b[i, 8], b[i, 9], b[i, 10], b[i, 11], b[i, 12])  # fmt: skip
+    for _ in range(params.substeps):
+        s = substep(s, ux, uy, params)
+    x[i, 0, 0], x[i, 0, 1] = s[0], s[3]
+    tilt_x, rate_x, tilt_y, rate_y = axis_view(s)
+    x[i, 0, 2], x[i, 0, 3] = tilt_x, rate_x
+    if two:
+        x[i, 1, 0], x[i, 1, 1], x[i, 1, 2], x[i, 1, 3] = s[1], s[4], tilt_y, rate_y
+    b[i, 0], b[i, 1] = s[2], s[5]
+    for m in range(11):
+        b[i, 2 + m] = s[6 + m]
+
+
+def attitude_of_tilts(tilt_x: float, tilt_y: float) -> tuple[float, float, float, float]:
+    """The quaternion ``(q_x, q_y, q_z, q_w)`` with these tilts and no yaw.
+
+    It is ``R = R_y(theta) R_x(rho)`` (yaw, pitch, roll = 0, ``theta``, ``rho``): ``theta = phi_x``
+    and ``tan(rho) = -tan(phi_y) cos(theta)`` give ``atan2(b_3x, b_3z) = phi_x`` and
+    ``atan2(b_3y, b_3z) = phi_y``.
+
+    Parameters
+    ----------
+    tilt_x, tilt_y : float
+        The tilts ``phi_x``, ``phi_y`` (rad), each within (-pi/2, pi/2).
+    """
+    theta = tilt_x
+    rho = -math.atan(math.tan(tilt_y) * math.cos(theta))
+    cr, sr, ct, st = math.cos(rho / 2), math.sin(rho / 2), math.cos(theta / 2), math.sin(theta / 2)
+    return sr * ct, cr * st, -sr * st, cr * ct
+
+
+class QuadrotorModel(VehicleModel):
+    """A nonlinear quadrotor (the Crazyflie 2.x by default) under the inner loop (Q5)-(Q8).
+
+    Parameters
+    ----------
+    params
+        The scenario's ``[model]`` table, :class:`~tmem.scenario.tables.QuadrotorModelParams`.
+    """
+
+    kind = "quadrotor"
+    state_names = STATE_NAMES
+    state_units = ("m", "m s-1", "rad", "rad s-1")
+    long_names = ("position", "velocity", "tilt of the thrust axis from the vertical along the axis", "tilt rate")
+    body_names = BODY_NAMES
+    body_units = BODY_UNITS
+    body_long_names = BODY_LONG_NAMES
+    step = step_quadrotor
+
+    def airframe(self) -> Airframe:
+        """The rigid body's numbers, from the ``[model]`` table."""
+        p = self.params
+        return Airframe(p.mass, p.g, p.ixx, p.iyy, p.izz, p.arm_length / math.sqrt(2.0), p.k_eta, p.k_m,
+                        p.rotor_drag, p.inflow_drag, p.c_dx, p.c_dy, p.c_dz, p.tau_m, p.rotor_speed_max)  # fmt: skip
+
+    def linearisation(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, B)`` on the x axis at hover, with the inner loop closed and the motors' lag taken to 0.
+
+        The gains are designed on the vehicle as the TMEM law flies it, so that its roots are
+        (5) on the vehicle itself.  At hover, rotor drag slows the velocity by
+        ``c_h = 4 k_d o_h / m`` and the rotors' inflow damps the body rate by
+        ``c_r = 4 k_z o_h a^2 / I_yy`` (``o_h``: hover rotor speed; ``a``: the hubs' offset); the
+        frame's drag is quadratic and adds nothing; the drag feed-forward (Q8) adds
+        ``c_h V / g`` to the set-point::
+
+            A = [[0, 1, 0, 0], [0, -c_h, g, 0], [0, 0, 0, 1], [0, f kp kd c_h / g, -kp kd, -kd - c_r]]
+            B = [0, 0, 0, kp kd]^T                (f = 1 with the feed-forward, else 0)
+
+        Without drag it is (2) exactly.  The y axis has ``I_xx`` for ``I_yy``: the same for a
+        symmetric frame (the Crazyflie's).  ``tests/test_quadrotor.py`` checks it against finite
+        differences of (Q1)-(Q8).
+        """
+        p, frame = self.params, self.airframe()
+        hover = hover_speed(frame)
+        c_h = 4.0 * p.rotor_drag * hover / p.mass
+        c_r = 4.0 * p.inflow_drag * hover * frame.offset**2 / p.iyy
+        feedforward = p.kp * p.kd * c_h / p.g if p.drag_feedforward else 0.0
+        a = np.array(
+            [
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, -c_h, p.g, 0.0],
+                [0.0, 0.0, 0.0, 1.0],
+                [0.0, feedforward, -p.kp * p.kd, -p.kd - c_r],
+            ]
+        )
+        return a, np.array([0.0, 0.0, 0.0, p.kp * p.kd])
+
+    def step_params(self, dt: float) -> QuadrotorStep:
+        """The airframe, the gains and the sub-steps of ``dt``: as many as keep each at most ``inner_period``.
+
+        Parameters
+        ----------
+        dt : float
+            The time step (s).
+        """
+        p = self.params
+        substeps = max(1, math.ceil(dt / p.inner_period - 1e-9))
+        return QuadrotorStep(*self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward,
+                             substeps, dt / substeps)  # fmt: skip
+
+    def initial_body(self, state: np.ndarray) -> np.ndarray:
+        """Body states for per-axis states: at height 0, not climbing, yaw 0, rotors carrying the weight.
+
+        The attitude has each axis's tilt (:func:`attitude_of_tilts`), the body rates give each
+        axis's tilt rate (:func:`axis_view` inverted) with no yaw rate.
+
+        Parameters
+        ----------
+        state : ndarray, shape (agents, axes, 4)
+        """
+        frame = self.airframe()
+        body = np.zeros((state.shape[0], len(BODY_NAMES)))
+        for i, agent in enumerate(state):
+            tilt_y, rate_y = (agent[1, 2], agent[1, 3]) if len(agent) > 1 else (0.0, 0.0)
+            q = attitude_of_tilts(agent[0, 2], tilt_y)
+            rest = (0.0,) * 6 + q
+            # The tilt rates are linear in (w_x, w_y): solve for the body rates that give them.
+            by_x, by_y = (np.array(axis_view(rest + (w_x, w_y, 0.0, 0.0, 0.0, 0.0, 0.0))[1::2]) for w_x, w_y in ((1.0, 0.0), (0.0, 1.0)))
+            w = np.linalg.solve(np.column_stack([by_x, by_y]), [agent[0, 3], rate_y])
+            b3z = rotation(*q)[8]
+            body[i, 2:6] = q
+            body[i, 6:8] = w
+            body[i, 9:] = math.sqrt(frame.mass * frame.g / (4.0 * frame.k_eta * b3z))
+        return body
