@@ -6,9 +6,10 @@ hands the true states on (:func:`exact`).  With one, the loop takes its
 sensed path (:mod:`tmem.engine.sensed`), where each receiver works from its
 own measurement; the model, in ``docs/sensing.md``:
 
-* **Broadcast.**  At every step ``k`` every agent sends its state
-  ``(P, V, phi, omega)``, a *message*; :func:`measure` keeps the last
-  ``depth`` steps of them, a ring buffer (:attr:`Sensing.history`).
+* **Broadcast.**  Every ``period`` (by default at every step) every agent
+  sends its state ``(P, V, phi, omega)``, a *message*; :func:`measure` keeps
+  the states of the last ``depth`` steps, a ring buffer
+  (:attr:`Sensing.history`).  Between messages a receiver holds the last.
 * **Delay.**  Message ``s`` from ``j`` reaches ``i`` ``tau`` later: from the
   first step at which it is ``tau`` old, step ``s + lag(tau)`` with
   ``lag(tau) = ceil(tau / dt)`` (:func:`tmem.scenario.sensing_table.lag`).
@@ -23,7 +24,7 @@ own measurement; the model, in ``docs/sensing.md``:
 * **Noise.**  A received message's position and velocity carry Gaussian
   noise, drawn once per message and receiver (a held message keeps its
   noise): :func:`known_component`.  An agent's own state carries noise of
-  its own, drawn at every step (:func:`measure`).
+  its own, drawn once a period and held over it (:func:`measure`).
 * **Range.**  A neighbour farther than ``range`` (true distance now) is not
   measured at all.
 * **Start.**  Until a neighbour's first message is due, a receiver knows the
@@ -70,6 +71,8 @@ class Sensing(NamedTuple):
         Standard deviation of the noise on a neighbour's position (m) and velocity (m/s), per axis.
     own_position_noise, own_velocity_noise : float
         The same on an agent's own state.
+    every : int
+        Steps between two messages of an agent, and between two measurements of its own state.
     lag_min, lag_max : int
         ``lag`` of the smallest and largest delay (steps); equal for a fixed delay.
     delay_min, delay_max : float
@@ -99,6 +102,7 @@ class Sensing(NamedTuple):
     velocity_noise: float
     own_position_noise: float
     own_velocity_noise: float
+    every: int
     lag_min: int
     lag_max: int
     delay_min: float
@@ -137,6 +141,7 @@ def sensing_of(settings: SensingParams, order: np.ndarray, shape: tuple, dt: flo
         velocity_noise=settings.velocity_noise,
         own_position_noise=settings.own_position_noise,
         own_velocity_noise=settings.own_velocity_noise,
+        every=settings.every(dt),
         lag_min=lag(delay_min, dt),
         lag_max=lag(delay_max, dt),
         delay_min=delay_min,
@@ -176,9 +181,9 @@ def _arrived(k, s, receiver, sender, sensing):
 def latest_message(k, i, j, sensing):
     """The step at which ``j`` sent the newest message ``i`` holds at step ``k``; -1 when it holds none.
 
-    Messages are searched from the newest that can have arrived back to the oldest kept, ``depth - 1``
-    steps old; the first that has arrived and was not lost is the one held.  Before the first
-    message is due, a receiver knows its neighbour's start (step 0).
+    Messages, sent at the multiples of ``every``, are searched from the newest that can have arrived
+    back to the oldest kept, ``depth - 1`` steps old; the first that has arrived and was not lost is
+    the one held.  Before the first message is due, a receiver knows its neighbour's start (step 0).
 
     Parameters
     ----------
@@ -195,6 +200,7 @@ def latest_message(k, i, j, sensing):
     receiver = sensing.agent[i]
     sender = sensing.agent[j]
     s = k - sensing.lag_min
+    s -= s % sensing.every  # Python's %: a step before the start stays before it
     while s > k - depth:
         if s <= 0:
             return 0
@@ -202,7 +208,7 @@ def latest_message(k, i, j, sensing):
             sensing.loss > 0.0 and uniform(sensing.seed, receiver, sender, s, LOSS) < sensing.loss
         ):
             return s
-        s -= 1
+        s -= sensing.every
     return -1
 
 
@@ -264,6 +270,7 @@ def measure(k, state, sensing):
     history, own, agent, seed = sensing.history, sensing.own, sensing.agent, sensing.seed  # parallel loops take arrays
     sigma_p, sigma_v = sensing.own_position_noise, sensing.own_velocity_noise
     depth = history.shape[0]
+    sample = k - k % sensing.every  # the own noise is drawn once a period
     for i in numba.prange(state.shape[0]):
         for a in range(state.shape[1]):
             for m in range(state.shape[2]):
@@ -271,7 +278,7 @@ def measure(k, state, sensing):
                 if depth > 0:
                     history[k % depth, i, a, m] = state[i, a, m]
             if sigma_p > 0.0:
-                own[i, a, 0] += sigma_p * normal(seed, agent[i], agent[i], k, NOISE + 2 * a)
+                own[i, a, 0] += sigma_p * normal(seed, agent[i], agent[i], sample, NOISE + 2 * a)
             if sigma_v > 0.0:
-                own[i, a, 1] += sigma_v * normal(seed, agent[i], agent[i], k, NOISE + 2 * a + 1)
+                own[i, a, 1] += sigma_v * normal(seed, agent[i], agent[i], sample, NOISE + 2 * a + 1)
     return own

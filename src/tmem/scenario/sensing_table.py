@@ -8,6 +8,8 @@ them); every default turns it off, so a table of defaults measures exactly:
 * ``own_position_noise``, ``own_velocity_noise`` — the same on the agent's own state;
 * ``delay`` — the age of a neighbour's data when it is used (s): one number, or ``[min, max]``
   for a delay drawn for each message uniformly between them;
+* ``period`` — the time (s) between two messages of an agent (default: one every step), and
+  between two measurements of its own state;
 * ``loss`` — the probability that a message from one agent to another is lost;
 * ``hold`` — how long (s) past its largest delay a receiver keeps using the last message it got;
 * ``range`` — the sensing range (m): an agent farther away is not measured at all;
@@ -77,6 +79,7 @@ class SensingParams(StrictModel):
     own_position_noise: NonNegative = 0.0
     own_velocity_noise: NonNegative = 0.0
     delay: Delay = 0.0
+    period: Positive | None = None
     loss: Annotated[float, Field(ge=0, lt=1)] = 0.0
     hold: Positive = 1.0
     range: Positive | None = None
@@ -90,19 +93,31 @@ class SensingParams(StrictModel):
     def exact(self) -> bool:
         """Whether every effect is off: the agents then know every state exactly."""
         noise = (self.position_noise, self.velocity_noise, self.own_position_noise, self.own_velocity_noise)
-        return not any(noise) and self.delays == (0.0, 0.0) and self.loss == 0.0 and self.range is None
+        unlimited = self.range is None and self.period is None
+        return not any(noise) and self.delays == (0.0, 0.0) and self.loss == 0.0 and unlimited
 
-    def depth(self, dt: float) -> int:
-        """How many past broadcasts a run keeps: enough for the largest delay, and the hold with loss.
-
-        0 when no message is delayed or lost: agents then read the states of the step.
+    def every(self, dt: float) -> int:
+        """Steps between two messages of an agent (``period / dt``; 1 without a period).
 
         Parameters
         ----------
         dt : float
             The step (s).
         """
-        oldest = lag(self.delays[1], dt) + (lag(self.hold, dt) if self.loss > 0.0 else 0)
+        return 1 if self.period is None else max(1, round(self.period / dt))
+
+    def depth(self, dt: float) -> int:
+        """How many past broadcasts a run keeps: enough for the largest delay and a period, and the
+        hold with loss.
+
+        0 when no message is delayed, held or lost: agents then read the states of the step.
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        """
+        oldest = lag(self.delays[1], dt) + self.every(dt) - 1 + (lag(self.hold, dt) if self.loss > 0.0 else 0)
         return oldest + 1 if oldest > 0 or self.loss > 0.0 else 0
 
 
@@ -130,6 +145,8 @@ def check_sensing(scenario: Scenario, n_agents: int, uses_lists: bool, limit: in
         raise FieldError("sensing.range", "is required when neighbours are found with lists (neighbors.method = "
                          "'verlet', or 'auto' from 64 agents): the lists hold the agents within range")  # fmt: skip
     dt = scenario.simulation.dt
+    if sensing.period is not None and abs(sensing.period / dt - sensing.every(dt)) > 1e-6 * sensing.every(dt):
+        raise FieldError("sensing.period", f"must be a whole number of steps dt = {dt:g} s, got {sensing.period:g}")
     kept = sensing.depth(dt) * n_agents * scenario.space.axes * MESSAGE_BYTES_PER_AXIS
     if kept > limit:
         field = "sensing.hold" if sensing.loss > 0.0 and lag(sensing.hold, dt) > lag(sensing.delays[1], dt) else "sensing.delay"
