@@ -2,8 +2,8 @@
 
 The ``fig9`` preset (improved switching (11), dt = 1e-4 s, uncouple command at t = 29 s) is run
 exactly, then with one effect at a time (``docs/sensing.md``): noise on the neighbour's position or
-velocity heard 10 times a second, a fixed delay of every message, and the loss of messages sent 10
-times a second.  Each noisy or lossy case runs with several seeds; the table gives the mean and, in
+velocity (or the agent's own) heard 10 times a second, messages 10 times a second without noise, a
+fixed delay of every message, and the loss of messages sent 10 times a second.  Each noisy or lossy case runs with several seeds; the table gives the mean and, in
 brackets, the smallest and largest value over them.  Prints the Markdown tables of
 ``docs/sensing.md``::
 
@@ -27,11 +27,12 @@ SEEDS = range(1, 6)
 #: (label, the [sensing] table, whether it draws random numbers), one row each.
 CASES = [
     ("exact", {}, False),
+    ("position noise 0.3 m, every step", {"position_noise": 0.3}, True),
     *[(f"position noise {s:g} m, 10 Hz", {"position_noise": s, "period": 0.1}, True) for s in (0.1, 0.3, 1.0)],
     *[(f"velocity noise {s:g} m/s, 10 Hz", {"velocity_noise": s, "period": 0.1}, True) for s in (0.1, 0.3)],
     ("own position noise 0.3 m, 10 Hz", {"own_position_noise": 0.3, "period": 0.1}, True),
     ("messages at 10 Hz, exact", {"period": 0.1}, False),
-    *[(f"delay {d * 1000:g} ms", {"delay": d}, False) for d in (0.01, 0.05, 0.1, 0.2, 0.3)],
+    *[(f"delay {d * 1000:g} ms", {"delay": d}, False) for d in (0.001, 0.01, 0.05, 0.1, 0.2, 0.3)],
     *[(f"loss {p:g}, 10 Hz", {"loss": p, "period": 0.1}, True) for p in (0.2, 0.5)],
 ]
 DASH = "—"

@@ -174,7 +174,7 @@ def _arrived(k, s, receiver, sender, sensing):
     if sensing.lag_min == sensing.lag_max:
         return k - s >= sensing.lag_min
     tau = sensing.delay_min + (sensing.delay_max - sensing.delay_min) * uniform(sensing.seed, receiver, sender, s, DELAY)
-    return k - s >= max(0, int(np.ceil(tau / sensing.dt - LAG_TOLERANCE)))
+    return k - s >= max(0, int(np.ceil(tau / sensing.dt - LAG_TOLERANCE)))  # tmem.scenario.sensing_table.lag
 
 
 @numba.njit(cache=True, inline="always")

@@ -285,17 +285,10 @@ def simulate(
     law, params = law_of(scenario, model.linearisation(), gains)
     swarm = _in_slots(scenario, initial, gains, record)
     x = swarm.agents.state
-    settings = scenario.sensing or SensingParams()
-    sensed = _sensed(scenario, settings, run, sensing)
-    edges = np.stack([swarm.pairs.i, swarm.pairs.j], axis=1)
-    lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], edges, run.use_lists,
-                              settings.range if sensed and run.use_lists else scenario.interaction.reach)  # fmt: skip
-    lister.p_ref[:] = x[..., 0] if sensed else interaction_point(x, gains)  # what the lists hold, at the start
+    lister, measured, sensed = _lists_and_measurement(scenario, run, swarm, gains, sensing)
     advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM, sensed)
-    if sensed:
-        measured = sensing_of(settings, swarm.order, x.shape, sim.dt, len(lister.block_ptr) - 1)._replace(**(sensing or {}))
     gas = gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0])
-    stages = (law, params, model.step_params(sim.dt), measured if sensed else exact(x), gas, wall_params(params, gas.wall_reach))
+    stages = (law, params, model.step_params(sim.dt), measured, gas, wall_params(params, gas.wall_reach))
     _drive(advance, run, stages, swarm, lister, progress, chunk_seconds)
     if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
@@ -320,6 +313,23 @@ def simulate(
         list_builds=lister.builds,
         gas=swarm.records.gas,
     )
+
+
+def _lists_and_measurement(scenario: Scenario, run: Run, swarm: _Slots, gains: np.ndarray, overrides: dict | None):
+    """The neighbour lister and the measurement stage (:class:`tmem.sensing.Sensing`), and whether the
+    run takes the sensed path.  The exact path lists ``P*`` (6) within ``R + R_j`` and the skin; the
+    sensed path the positions within the sensing range and the skin."""
+    x = swarm.agents.state
+    settings = scenario.sensing or SensingParams()
+    sensed = _sensed(scenario, settings, run, overrides)
+    edges = np.stack([swarm.pairs.i, swarm.pairs.j], axis=1)
+    reach = settings.range if sensed and run.use_lists else scenario.interaction.reach
+    lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], edges, run.use_lists, reach)
+    lister.p_ref[:] = x[..., 0] if sensed else interaction_point(x, gains)  # what the lists hold, at the start
+    if not sensed:
+        return lister, exact(x), False
+    blocks = len(lister.block_ptr) - 1
+    return lister, sensing_of(settings, swarm.order, x.shape, scenario.simulation.dt, blocks)._replace(**(overrides or {})), True
 
 
 def _sensed(scenario: Scenario, settings: SensingParams, run: Run, overrides: dict | None) -> bool:

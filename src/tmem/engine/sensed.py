@@ -71,8 +71,9 @@ def _sensed_pushes_of(k, state, corrected, pairs, first, stop, box, function, pa
             dist2 += delta * delta
         if dist2 >= sensing.range2:
             continue
-        near = _receiver_push(k, state, corrected, i, j, sensing, gains, box, function, params, w, u)
-        if _receiver_push(k, state, corrected, j, i, sensing, gains, box, function, params, w, u) or near:
+        i_near = _receiver_push(k, state, corrected, i, j, sensing, gains, box, function, params, w, u)
+        j_near = _receiver_push(k, state, corrected, j, i, sensing, gains, box, function, params, w, u)
+        if i_near or j_near:
             nearest2 = min(nearest2, dist2)
     return nearest2
 
