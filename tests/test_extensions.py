@@ -81,10 +81,10 @@ EXTENSIONS = {
     ],
     "sensing effect": [
         ("sensing.py", "    work: np.ndarray\n", "    work: np.ndarray\n    quantum: float = 0.0\n"),
-        ("sensing.py", "    return value\n", textwrap.indent(textwrap.dedent('''\
-            if m == 0 and sensing.quantum > 0.0:  # "quantised": positions known to the nearest multiple of quantum
-                value = np.round(value / sensing.quantum) * sensing.quantum
-            return value
+        ("sensing.py", "    return p, v, phi, omega\n", textwrap.indent(textwrap.dedent('''\
+            if sensing.quantum > 0.0:  # "quantised": positions known to the nearest multiple of quantum
+                p = np.round(p / sensing.quantum) * sensing.quantum
+            return p, v, phi, omega
         '''), "    ")),
     ],
 }

@@ -59,8 +59,8 @@ def held_message(tr: tmem.Trajectory) -> np.ndarray:
 
 def test_the_hash_is_splitmix64():
     """The compiled hash against a pure-Python SplitMix64 (Vigna's splitmix64.c): its first output
-    from state 0 is the published 0xE220A8397B1DCDAF, and the chain over the five numbers matches."""
-    from tmem.streams import bits, mix
+    from state 0 is the published 0xE220A8397B1DCDAF, and a draw is the chain over its five numbers."""
+    from tmem.streams import message_key, mix, uniform
 
     mask = 2**64 - 1
 
@@ -78,22 +78,26 @@ def test_the_hash_is_splitmix64():
         h = reference(seed)
         for value in (receiver, sender, step, draw):
             h = reference((h + value) & mask)
-        assert int(bits(seed, receiver, sender, step, draw)) == h
+        key = np.uint64(message_key(seed, receiver, sender, step))  # from Python an int: as the loop types it
+        assert uniform(key, draw) == ((h >> 11) + 0.5) / 2**53
 
 
 def test_normal_draws_are_standard_normal_and_independent():
-    """100 000 draws over steps and senders: mean, variance (chi-square), Kolmogorov-Smirnov against
-    the normal law, and no correlation between neighbouring steps or draws."""
-    from tmem.streams import normal
+    """100 000 pairs of draws over steps and senders: each draw's mean, variance (chi-square) and
+    Kolmogorov-Smirnov test against the normal law, and no correlation within a pair, between
+    pairs of one message, or between neighbouring steps."""
+    from tmem.streams import message_key, normal_pair
 
     n = 100_000
-    x = np.array([normal(5, 2, 1 + k % 7, k, 3) for k in range(n)])
-    y = np.array([normal(5, 2, 1 + k % 7, k, 4) for k in range(n)])
-    assert abs(x.mean()) < Z / np.sqrt(n)
-    chi2 = (n - 1) * x.var(ddof=1)
-    assert stats.chi2.ppf(LEVEL / 2, n - 1) < chi2 < stats.chi2.isf(LEVEL / 2, n - 1)
-    assert stats.kstest(x, "norm").pvalue > LEVEL
-    for a, b in ((x[1:], x[:-1]), (x, y)):
+    keys = [np.uint64(message_key(5, 2, 1 + k % 7, k)) for k in range(n)]
+    first, second = np.array([normal_pair(key, 1) for key in keys]).T
+    other = np.array([normal_pair(key, 2)[0] for key in keys])
+    for x in (first, second):
+        assert abs(x.mean()) < Z / np.sqrt(n)
+        chi2 = (n - 1) * x.var(ddof=1)
+        assert stats.chi2.ppf(LEVEL / 2, n - 1) < chi2 < stats.chi2.isf(LEVEL / 2, n - 1)
+        assert stats.kstest(x, "norm").pvalue > LEVEL
+    for a, b in ((first, second), (first, other), (first[1:], first[:-1])):
         assert abs(np.corrcoef(a, b)[0, 1]) < Z / np.sqrt(n)
 
 

@@ -23,7 +23,7 @@ own measurement; the model, in ``docs/sensing.md``:
   older than the largest delay; then the neighbour is no longer measured.
 * **Noise.**  A received message's position and velocity carry Gaussian
   noise, drawn once per message and receiver (a held message keeps its
-  noise): :func:`known_component`.  An agent's own state carries noise of
+  noise): :func:`known_axis`.  An agent's own state carries noise of
   its own, drawn once a period and held over it (:func:`measure`).
 * **Range.**  A neighbour farther than ``range`` (true distance now) is not
   measured at all.
@@ -35,8 +35,8 @@ Every draw is a hash of ``(seed, receiver, sender, step, draw)``
 threads, on the kind of neighbour list, or on the order of pairs.
 
 A new effect is a parameter in :class:`Sensing` (with a value that turns it
-off) and a line in :func:`known_component`, or in :func:`measure` for an
-agent's own state (``docs/architecture.md`` walks through one).
+off) and a line in :func:`known_axis`, or in :func:`measure` for an agent's
+own state (``docs/architecture.md`` walks through one).
 """
 
 from __future__ import annotations
@@ -49,12 +49,12 @@ import numpy as np
 from . import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from .control import corrected_position
 from .scenario.sensing_table import LAG_TOLERANCE, SensingParams, lag
-from .streams import normal, uniform
+from .streams import message_key, normal_pair, uniform
 
 #: The uniform draws of a message: whether it is lost, and its delay.
 LOSS, DELAY = 0, 1
-#: The first normal draw of the noise (it takes the uniform draws 2 and 3); on axis ``a`` the
-#: position's is ``NOISE + 2 a``, the velocity's ``NOISE + 2 a + 1``.
+#: The first pair of normal draws of the noise (it takes the uniform draws 2 and 3): on axis ``a``
+#: the pair ``NOISE + a`` gives the position's noise and the velocity's.
 NOISE = 1
 
 
@@ -169,11 +169,27 @@ def exact(state: np.ndarray) -> Sensing:
 
 
 @numba.njit(cache=True, inline="always")
-def _arrived(k, s, receiver, sender, sensing):
-    """Whether message ``s`` of ``sender`` has reached ``receiver`` by step ``k`` (agents by number)."""
+def message_of(sensing, i, j, s):
+    """The stream key of message ``s`` from slot ``j`` to slot ``i`` (:func:`tmem.streams.message_key`).
+
+    Parameters
+    ----------
+    sensing : Sensing
+        The measurement stage.
+    i, j : int
+        Slots of the receiver and the sender (the same for an agent's measure of itself).
+    s : int
+        The step the message was sent.
+    """
+    return message_key(sensing.seed, sensing.agent[i], sensing.agent[j], s)
+
+
+@numba.njit(cache=True, inline="always")
+def _arrived(k, s, key, sensing):
+    """Whether message ``s`` (stream key ``key``) has reached its receiver by step ``k``."""
     if sensing.lag_min == sensing.lag_max:
         return k - s >= sensing.lag_min
-    tau = sensing.delay_min + (sensing.delay_max - sensing.delay_min) * uniform(sensing.seed, receiver, sender, s, DELAY)
+    tau = sensing.delay_min + (sensing.delay_max - sensing.delay_min) * uniform(key, DELAY)
     return k - s >= max(0, int(np.ceil(tau / sensing.dt - LAG_TOLERANCE)))  # tmem.scenario.sensing_table.lag
 
 
@@ -197,61 +213,63 @@ def latest_message(k, i, j, sensing):
     depth = sensing.history.shape[0]
     if depth == 0:
         return k
-    receiver = sensing.agent[i]
-    sender = sensing.agent[j]
     s = k - sensing.lag_min
     s -= s % sensing.every  # Python's %: a step before the start stays before it
     while s > k - depth:
         if s <= 0:
             return 0
-        if _arrived(k, s, receiver, sender, sensing) and not (
-            sensing.loss > 0.0 and uniform(sensing.seed, receiver, sender, s, LOSS) < sensing.loss
-        ):
+        key = message_of(sensing, i, j, s)
+        if _arrived(k, s, key, sensing) and not (sensing.loss > 0.0 and uniform(key, LOSS) < sensing.loss):
             return s
         s -= sensing.every
     return -1
 
 
-@numba.njit(cache=True, inline="always")
-def known_component(state, sensing, i, j, s, a, m):
-    """Component ``m`` on axis ``a`` of ``j``'s state as ``i`` knows it from ``j``'s message ``s``.
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def known_axis(state, sensing, key, j, s, a):
+    """``(P, V, phi, omega)`` of ``j`` on axis ``a`` as its receiver knows it from ``j``'s message ``s``.
 
     Parameters
     ----------
     state : ndarray, shape (agents, axes, n_state)
-        The true states of this step (read when nothing is delayed or lost).
+        The true states of this step (read when nothing is delayed, held or lost).
     sensing : Sensing
         The measurement stage.
-    i, j : int
-        Slots of the receiver and the sender.
+    key : uint64
+        The message's stream key (:func:`message_of`).
+    j : int
+        Slot of the sender.
     s : int
         The message (the step it was sent; :func:`latest_message`).
-    a, m : int
-        The axis and the component (0: position, 1: velocity, ...).
+    a : int
+        The axis.
     """
     depth = sensing.history.shape[0]
-    value = state[j, a, m] if depth == 0 else sensing.history[s % depth, j, a, m]
-    if m == 0 and sensing.position_noise > 0.0:
-        value += sensing.position_noise * normal(sensing.seed, sensing.agent[i], sensing.agent[j], s, NOISE + 2 * a)
-    elif m == 1 and sensing.velocity_noise > 0.0:
-        value += sensing.velocity_noise * normal(sensing.seed, sensing.agent[i], sensing.agent[j], s, NOISE + 2 * a + 1)
-    return value
+    if depth == 0:
+        p, v, phi, omega = state[j, a, 0], state[j, a, 1], state[j, a, 2], state[j, a, 3]
+    else:
+        history, row = sensing.history, s % depth
+        p, v, phi, omega = history[row, j, a, 0], history[row, j, a, 1], history[row, j, a, 2], history[row, j, a, 3]
+    if sensing.position_noise > 0.0 or sensing.velocity_noise > 0.0:
+        noise_p, noise_v = normal_pair(key, NOISE + a)
+        p += sensing.position_noise * noise_p
+        v += sensing.velocity_noise * noise_v
+    return p, v, phi, omega
 
 
 @numba.njit(cache=True, inline="always")
-def known_corrected(state, sensing, gains, i, j, s, a):
-    """``P*`` (6) of ``j`` on axis ``a`` as ``i`` knows it from message ``s`` (with ``j``'s gains).
+def known_corrected(state, sensing, gains, key, j, s, a):
+    """``P*`` (6) of ``j`` on axis ``a`` as its receiver knows it from message ``s`` (with ``j``'s gains).
 
     Parameters
     ----------
-    state, sensing, i, j, s, a
-        As :func:`known_component` takes them.
+    state, sensing, key, j, s, a
+        As :func:`known_axis` takes them.
     gains : ndarray, shape (agents, 4) or (1, 4)
         Each agent's ``K`` (:class:`tmem.engine.records.Law`).
     """
-    return corrected_position(known_component(state, sensing, i, j, s, a, 0), known_component(state, sensing, i, j, s, a, 1),
-                              known_component(state, sensing, i, j, s, a, 2), known_component(state, sensing, i, j, s, a, 3),
-                              gains, j)  # fmt: skip
+    p, v, phi, omega = known_axis(state, sensing, key, j, s, a)
+    return corrected_position(p, v, phi, omega, gains, j)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -267,7 +285,7 @@ def measure(k, state, sensing):
     sensing : Sensing
         The measurement stage; its ``history`` and ``own`` change in place.
     """
-    history, own, agent, seed = sensing.history, sensing.own, sensing.agent, sensing.seed  # parallel loops take arrays
+    history, own = sensing.history, sensing.own  # parallel loops take arrays
     sigma_p, sigma_v = sensing.own_position_noise, sensing.own_velocity_noise
     depth = history.shape[0]
     sample = k - k % sensing.every  # the own noise is drawn once a period
@@ -277,8 +295,10 @@ def measure(k, state, sensing):
                 own[i, a, m] = state[i, a, m]
                 if depth > 0:
                     history[k % depth, i, a, m] = state[i, a, m]
-            if sigma_p > 0.0:
-                own[i, a, 0] += sigma_p * normal(seed, agent[i], agent[i], sample, NOISE + 2 * a)
-            if sigma_v > 0.0:
-                own[i, a, 1] += sigma_v * normal(seed, agent[i], agent[i], sample, NOISE + 2 * a + 1)
+        if sigma_p > 0.0 or sigma_v > 0.0:
+            key = message_of(sensing, i, i, sample)
+            for a in range(state.shape[1]):
+                noise_p, noise_v = normal_pair(key, NOISE + a)
+                own[i, a, 0] += sigma_p * noise_p
+                own[i, a, 1] += sigma_v * noise_v
     return own

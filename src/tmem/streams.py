@@ -1,7 +1,9 @@
 """Counter-based random streams: every draw a hash of who, when and what, in compiled code.
 
 A draw is a function of ``(seed, receiver, sender, step, draw)`` alone, with
-no generator state carried from one draw to the next.  What agent ``i``
+no generator state carried from one draw to the next: the first four, a
+*message*, are hashed once (:func:`message_key`), and each draw of the message
+is one more mix of that key with its number.  What agent ``i``
 measures of agent ``j`` at a step therefore does not depend on the order in
 which the loop visits pairs, on the number of threads, or on which pairs a
 neighbour list happens to hold: the same scenario gives the same bits every
@@ -10,12 +12,12 @@ way it is run (:mod:`tmem.sensing` draws its noise, delays and losses here).
 The hash chains SplitMix64's finaliser (Steele, Lea and Flood, "Fast
 splittable pseudorandom number generators", OOPSLA 2014; the reference
 ``splitmix64.c`` of Vigna) over the five numbers: each is added to the hash so
-far with the golden-ratio increment, and the sum is mixed.  Agents are named
+far, and the sum is mixed with the golden-ratio increment.  Agents are named
 by their number in the scenario, not by their slot in the loop.
 
-:func:`uniform` and :func:`normal` are called, not inlined: the sensed loop
-draws in a dozen places, and each inlined copy of the hash and of Box-Muller
-lengthened its first compilation.
+:func:`uniform` and :func:`normal_pair` are called, not inlined: the sensed
+loop draws in a dozen places, and each inlined copy of the hash and of
+Box-Muller lengthened its first compilation.
 """
 
 from __future__ import annotations
@@ -50,8 +52,8 @@ def mix(z):
 
 
 @numba.njit(cache=True, inline="always")
-def bits(seed, receiver, sender, step, draw):
-    """64 random bits of one draw: the hash of its five numbers.
+def message_key(seed, receiver, sender, step):
+    """The hash of a message's four numbers, from which each of its draws is one more mix.
 
     Parameters
     ----------
@@ -60,40 +62,41 @@ def bits(seed, receiver, sender, step, draw):
     receiver, sender : int
         The agents' numbers in the scenario (the same for an agent's measure of itself).
     step : int
-        The step the draw belongs to (for a message, the step it was sent), >= 0.
-    draw : int
-        Which draw of that message, >= 0 (:data:`tmem.sensing.LOSS`, ...).
+        The step the message belongs to (the step it was sent), >= 0.
     """
     h = mix(np.uint64(seed))
     h = mix(h + np.uint64(receiver))
     h = mix(h + np.uint64(sender))
-    h = mix(h + np.uint64(step))
-    return mix(h + np.uint64(draw))
+    return mix(h + np.uint64(step))
 
 
 @numba.njit(cache=True)
-def uniform(seed, receiver, sender, step, draw):
-    """A draw uniform on (0, 1), never 0 nor 1: the top 53 bits, centred in their interval.
+def uniform(key, draw):
+    """Draw ``draw`` of the message ``key``, uniform on (0, 1), never 0 nor 1: the top 53 bits of
+    ``mix(key + draw)``, centred in their interval.
 
     Parameters
     ----------
-    seed, receiver, sender, step, draw : int
-        As :func:`bits` takes them.
+    key : uint64
+        :func:`message_key`.
+    draw : int
+        Which draw of that message, >= 0 (:data:`tmem.sensing.LOSS`, ...).
     """
-    return (np.float64(bits(seed, receiver, sender, step, draw) >> _S11) + 0.5) * _UNIT
+    return (np.float64(mix(np.uint64(key) + np.uint64(draw)) >> _S11) + 0.5) * _UNIT
 
 
 @numba.njit(cache=True, error_model="numpy")
-def normal(seed, receiver, sender, step, draw):
-    """A standard normal draw (Box-Muller on the uniform draws ``2 draw`` and ``2 draw + 1``).
+def normal_pair(key, draw):
+    """Two independent standard normal draws of the message ``key``: Box-Muller on its uniform draws
+    ``2 draw`` and ``2 draw + 1``.
 
     Parameters
     ----------
-    seed, receiver, sender, step : int
-        As :func:`bits` takes them.
+    key : uint64
+        :func:`message_key`.
     draw : int
-        Which normal draw of that message, >= 0.
+        Which pair of normal draws of that message, >= 0.
     """
-    u1 = uniform(seed, receiver, sender, step, 2 * draw)
-    u2 = uniform(seed, receiver, sender, step, 2 * draw + 1)
-    return np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * u2)
+    radius = np.sqrt(-2.0 * np.log(uniform(key, 2 * draw)))
+    angle = 2.0 * np.pi * uniform(key, 2 * draw + 1)
+    return radius * np.cos(angle), radius * np.sin(angle)

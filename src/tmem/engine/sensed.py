@@ -30,7 +30,7 @@ import numpy as np
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from ..control import corrected_position
 from ..interaction.kernels import pair_control
-from ..sensing import known_component, known_corrected, latest_message
+from ..sensing import known_axis, known_corrected, latest_message, message_of
 from ..space import nearest_image
 from ..synchronise import synchronising_push
 from .pairs import check_flag, pair_push, released_if_lost, synchronise
@@ -43,10 +43,11 @@ def _receiver_push(k, state, corrected, receiver, sender, sensing, gains, box, f
     s = latest_message(k, receiver, sender, sensing)
     if s < 0:
         return False
+    key = message_of(sensing, receiver, sender, s)
     d = sensing.work
     r2 = 0.0
     for a in range(len(box)):
-        d[w, a] = nearest_image(known_corrected(state, sensing, gains, receiver, sender, s, a) - corrected[receiver, a, 0], box[a])
+        d[w, a] = nearest_image(known_corrected(state, sensing, gains, key, sender, s, a) - corrected[receiver, a, 0], box[a])
         r2 += d[w, a] * d[w, a]
     if not (r2 < params.reach * params.reach and r2 > 0.0):
         return False
@@ -132,12 +133,17 @@ def _pair_view(k, e, receiver, state, pairs, law, sensing, box, d):
     s = latest_message(k, receiver, partner, sensing)
     if s < 0:
         return np.nan
+    key = message_of(sensing, receiver, partner, s)
     states = sensing.pair_states
     r2 = 0.0
     for a in range(len(box)):
-        for m in range(states.shape[2]):
+        p, v, phi, omega = known_axis(state, sensing, key, partner, s, a)
+        states[1 - own_row, a, 0] = p
+        states[1 - own_row, a, 1] = v
+        states[1 - own_row, a, 2] = phi
+        states[1 - own_row, a, 3] = omega
+        for m in range(4):
             states[own_row, a, m] = sensing.own[receiver, a, m]
-            states[1 - own_row, a, m] = known_component(state, sensing, receiver, partner, s, a, m)
         star_i = corrected_position(states[0, a, 0], states[0, a, 1], states[0, a, 2], states[0, a, 3], law.gains, i)
         star_j = corrected_position(states[1, a, 0], states[1, a, 1], states[1, a, 2], states[1, a, 3], law.gains, j)
         d[a] = nearest_image(star_j - star_i, box[a])
