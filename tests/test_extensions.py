@@ -80,19 +80,11 @@ EXTENSIONS = {
         ("scenario/tables.py", "LinearModelParams | QuadrotorModelParams,", "LinearModelParams | QuadrotorModelParams | DragModelParams,"),
     ],
     "sensing effect": [
-        ("sensing.py", 'EFFECTS = ("identity",)', 'EFFECTS = ("identity", "quantised")'),
-        ("sensing.py", "    known: np.ndarray\n", "    known: np.ndarray\n    quantum: float = 0.0\n"),
-        ("sensing.py", "    return state\n", textwrap.indent(textwrap.dedent('''\
-            if sensing.effect == IDENTITY:
-                return state
-            # "quantised": positions known to the nearest multiple of quantum, the rest exactly.
-            known = sensing.known
-            for i in range(state.shape[0]):
-                for a in range(state.shape[1]):
-                    known[i, a, 0] = np.round(state[i, a, 0] / sensing.quantum) * sensing.quantum
-                    for m in range(1, state.shape[2]):  # element by element: the serial loop has no runtime
-                        known[i, a, m] = state[i, a, m]
-            return known
+        ("sensing.py", "    work: np.ndarray\n", "    work: np.ndarray\n    quantum: float = 0.0\n"),
+        ("sensing.py", "    return p, v, phi, omega\n", textwrap.indent(textwrap.dedent('''\
+            if sensing.quantum > 0.0:  # "quantised": positions known to the nearest multiple of quantum
+                p = np.round(p / sensing.quantum) * sensing.quantum
+            return p, v, phi, omega
         '''), "    ")),
     ],
 }
@@ -180,21 +172,20 @@ def test_a_new_vehicle_model_gets_its_gains_placed_and_flies_its_own_dynamics(ex
 
 
 def test_a_new_sensing_effect_changes_what_the_agents_know(extended):
-    """Positions known to the nearest metre: agents at 0 and 30.4 m push as if 30 m apart (attraction,
-    unsaturated: K_P (30 - 35)); with a quantum of 1e-9 m the run is the exact one to 1e-9."""
+    """Neighbours' positions known to the nearest metre: agent 0 at 0 m pushes as if agent 1, at 30.4 m,
+    were 30 m away (attraction, unsaturated: K_P (30 - 35)); with a quantum of 1e-9 m the run is the
+    exact one to 1e-9."""
     out = run(extended, '''
         import json
         import numpy as np
         import tmem
         from tmem.scenario import from_dict
-        from tmem.sensing import Sensing, EFFECTS
         s = from_dict({"interaction": {"function": "attraction", "c_max": 1.0},
                        "agents": [{"position": 0.0}, {"position": 30.4}],
                        "simulation": {"dt": 0.01, "duration": 5.0, "record_every": 1}})
         exact = tmem.simulate(s)
-        known = lambda q: Sensing(EFFECTS.index("quantised"), np.empty((2, 1, 4)), q)
-        metre = tmem.simulate(s, sensing=known(1.0))
-        fine = tmem.simulate(s, sensing=known(1e-9))
+        metre = tmem.simulate(s, sensing={"quantum": 1.0})
+        fine = tmem.simulate(s, sensing={"quantum": 1e-9})
         print(json.dumps({"k_p": float(exact.gains[0]), "first": float(metre.control[0, 0, 0]),
                           "fine": float(np.abs(fine.state - exact.state).max())}))
     ''')

@@ -237,6 +237,8 @@ def unsupported(scenario: Scenario) -> str | None:
         return "needs open space: free flight is skipped in closed form, without walls, obstacles or a box to wrap in"
     if scenario.gas_observed:
         return "the gas's options (thermostat, mean of pushes, observed totals) are the step loop's"
+    if scenario.sensing is not None and not scenario.sensing.exact:
+        return "the agents measure each other exactly: sensing effects ([sensing]) are the step loop's"
     if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
         return "at most one command, an uncouple"
     if any(not np.all(np.equal(a.tilt, 0)) or not np.all(np.equal(a.tilt_rate, 0)) or not a.active for a in scenario.agents):

@@ -18,9 +18,10 @@ The rows recorded so far and the events so far are saved up to the counters that
 the agents' slots are made again from the scenario.  The list is derived from the records'
 fields, so a field added to a record later is saved without a change here.
 
-The step loop draws no random numbers: a scenario's random streams (a ``[swarm]``'s starts, a
-formation's jitter) are drawn from their seeds before the first step, and drawn again identically
-when a run resumes.
+A scenario's random streams (a ``[swarm]``'s starts, a formation's jitter) are drawn from their
+seeds before the first step, and drawn again identically when a run resumes.  The measurement
+stage's noise, delays and losses are counter-based draws (:mod:`tmem.streams`), a function of the
+seed, the agent and the step alone: there is no generator state to save.
 
 A checkpoint is used only by the run that made it (:func:`fingerprint`): the same scenario as tmem
 reads it, the same recording and sensing, and the same versions of tmem, Numba and NumPy.  Any
@@ -46,7 +47,7 @@ from .. import __version__
 from ..interaction.kernels import FunctionParams
 from ..outputs import write_atomically
 from ..scenario import Scenario
-from ..sensing import IDENTITY, Sensing
+from ..sensing import Sensing
 from .records import Agents, Commands, Counters, Events, Gas, Law, Neighbours, Pairs, Records, Run
 
 #: The records that change during a run, under the names a checkpoint gives their fields.
@@ -77,7 +78,10 @@ REBUILT = {
         **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "wall_reach", "energy_scale", "c_max"), _FIXED),
         "work": _WORK, "pushed": _WORK,
     },
-    "sensing": {"effect": _FIXED},
+    "sensing": {
+        **dict.fromkeys((f for f in Sensing._fields if f not in ("history", "own", "pair_states", "pushes", "work")), _FIXED),
+        **dict.fromkeys(("own", "pair_states", "pushes", "work"), _WORK),
+    },
 }  # fmt: skip
 #: Fields filled row by row, and the counter of filled rows: a checkpoint holds those rows only.
 ROWS = {
@@ -140,11 +144,12 @@ def checkpoint_path(out: str | Path) -> Path:
     return out.parent / f".{kept}.tmem-checkpoint.npz"
 
 
-def fingerprint(scenario: Scenario, record: bool, sensing: Sensing | None) -> str:
+def fingerprint(scenario: Scenario, record: bool, sensing: dict | None) -> str:
     """What a checkpoint must have been made by: a SHA-256 of the scenario and the run's settings.
 
     The scenario as tmem reads it (:meth:`~tmem.scenario.Scenario.to_toml`, every value written
-    out: comments and layout do not count), whether it is recorded, and the sensing effect.
+    out: comments and layout do not count, its ``[sensing]`` table included), whether it is recorded,
+    and the measurement stage's fields set over that table.
 
     Parameters
     ----------
@@ -152,11 +157,11 @@ def fingerprint(scenario: Scenario, record: bool, sensing: Sensing | None) -> st
         The run's scenario.
     record : bool
         Whether the run records (:func:`tmem.simulate`'s ``record``).
-    sensing : Sensing or None
-        The run's sensing (None: every state exactly).
+    sensing : dict or None
+        :func:`tmem.simulate`'s ``sensing``: fields of the measurement stage set over the table.
     """
-    effect = IDENTITY if sensing is None else sensing.effect
-    text = f"{scenario.to_toml()}\nrecord = {record}\nsensing = {effect}\n"
+    overrides = None if sensing is None else sorted((k, repr(v)) for k, v in sensing.items())
+    text = f"{scenario.to_toml()}\nrecord = {record}\nsensing = {overrides}\n"
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -243,7 +248,7 @@ class Checkpoints:
         """The simulated time (s) of the checkpoint last written or read; None before."""
         return None if self.saved_step is None else round(self.saved_step * self._dt, 12)
 
-    def start(self, scenario: Scenario, record: bool = True, sensing: Sensing | None = None) -> Saved | None:
+    def start(self, scenario: Scenario, record: bool = True, sensing: dict | None = None) -> Saved | None:
         """Begin a run: check ``every`` against its time step, and read the checkpoint it left, if any.
 
         Parameters
@@ -252,8 +257,8 @@ class Checkpoints:
             The run's scenario.
         record : bool
             Whether the run records.
-        sensing : Sensing or None
-            The run's sensing (None: every state exactly).
+        sensing : dict or None
+            :func:`tmem.simulate`'s ``sensing``: fields of the measurement stage set over the table.
 
         Returns
         -------

@@ -29,7 +29,8 @@ from ..interaction.registry import code, uses_coupling
 from ..model import vehicle_model
 from ..neighbors import all_pairs, arrange, spatial_order, verlet_pairs
 from ..scenario import Scenario
-from ..sensing import Sensing, exact
+from ..scenario.sensing_table import SensingParams
+from ..sensing import exact, sensing_of
 from ..synchronise import coupled_mode, synchronising_gain
 from .checkpoint import Checkpoints, Saved, restore
 from .loop import advance_for
@@ -40,8 +41,6 @@ from .records import (
 )  # fmt: skip
 from .trajectory import DIVERGED, Event, SimulationError, Trajectory
 
-#: Swarms at least this large use Verlet lists ("auto").
-LARGE_SWARM = 64
 #: Swarms at least this large step on threads: below, starting the threads at every step costs more
 #: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal
 #: at 10^4).
@@ -134,10 +133,14 @@ def _partners(n_agents: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 class _NeighbourLister:
-    """Lists the pairs of flying agents in the loop's order, with Verlet lists or every pair."""
+    """Lists the pairs of flying agents in the loop's order, with Verlet lists or every pair.
 
-    def __init__(self, scenario: Scenario, n_agents: int, n_axes: int, edges_in_slots: np.ndarray, use_lists: bool):
-        self.cutoff = scenario.interaction.reach + scenario.neighbors.skin
+    The lists hold the pairs within ``reach`` and the skin of each other in ``p_ref``: ``P*`` (6) and
+    ``R + R_j`` on the exact path, the positions and the sensing range on the sensed one."""
+
+    def __init__(self, scenario: Scenario, n_agents: int, n_axes: int, edges_in_slots: np.ndarray, use_lists: bool,
+                 reach: float):  # fmt: skip
+        self.cutoff = reach + scenario.neighbors.skin
         self.use_lists = use_lists
         self.adj_ptr, self.adj_idx = _partners(n_agents, edges_in_slots)
         self.block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
@@ -252,7 +255,7 @@ def simulate(
     progress: Callable[[int, int], None] | None = None,
     chunk_seconds: float = 0.1,
     record: bool = True,
-    sensing: Sensing | None = None,
+    sensing: dict | None = None,
     checkpoints: Checkpoints | None = None,
 ) -> Trajectory:
     """Run a scenario and return its :class:`~tmem.engine.trajectory.Trajectory`.
@@ -269,7 +272,10 @@ def simulate(
     record
         ``False`` records nothing but the end state (for benchmarks).
     sensing
-        What the agents know of each other (:mod:`tmem.sensing`); default: every state exactly.
+        Fields of the measurement stage's record (:class:`tmem.sensing.Sensing`) set over the ones of
+        the scenario's ``[sensing]`` table, for effects the table does not name; given, even empty,
+        the run takes the sensed path.  By default the table decides: without effects, every agent
+        knows every state exactly.
     checkpoints
         Save the run's state at these checkpoints (:mod:`tmem.engine.checkpoint`), and go on from
         the one a killed run of the same scenario left; default: none.
@@ -294,12 +300,10 @@ def simulate(
     law, params = law_of(scenario, model.linearisation(), gains)
     swarm = _in_slots(scenario, initial, gains, record, model.initial_body(initial.state))
     x = swarm.agents.state
-    lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], np.stack([swarm.pairs.i, swarm.pairs.j], axis=1), run.use_lists)
-    lister.p_ref[:] = interaction_point(x, gains)  # P* (6) at the start
-    advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM)
-    sensing = exact(x) if sensing is None else sensing
+    lister, measured, sensed = _lists_and_measurement(scenario, run, swarm, gains, sensing)
+    advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM, sensed)
     gas = gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0])
-    stages = (law, params, model.step_params(sim.dt), sensing, gas, wall_params(params, gas.wall_reach))
+    stages = (law, params, model.step_params(sim.dt), measured, gas, wall_params(params, gas.wall_reach))
     _drive(advance, run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)
     if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
@@ -328,12 +332,39 @@ def simulate(
     )
 
 
+def _lists_and_measurement(scenario: Scenario, run: Run, swarm: _Slots, gains: np.ndarray, overrides: dict | None):
+    """The neighbour lister and the measurement stage (:class:`tmem.sensing.Sensing`), and whether the
+    run takes the sensed path.  The exact path lists ``P*`` (6) within ``R + R_j`` and the skin; the
+    sensed path the positions within the sensing range and the skin."""
+    x = swarm.agents.state
+    settings = scenario.sensing or SensingParams()
+    sensed = _sensed(scenario, settings, run, overrides)
+    edges = np.stack([swarm.pairs.i, swarm.pairs.j], axis=1)
+    reach = settings.range if sensed and run.use_lists else scenario.interaction.reach
+    lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], edges, run.use_lists, reach)
+    lister.p_ref[:] = x[..., 0] if sensed else interaction_point(x, gains)  # what the lists hold, at the start
+    if not sensed:
+        return lister, exact(x), False
+    blocks = len(lister.block_ptr) - 1
+    return lister, sensing_of(settings, swarm.order, x.shape, scenario.simulation.dt, blocks)._replace(**(overrides or {})), True
+
+
+def _sensed(scenario: Scenario, settings: SensingParams, run: Run, overrides: dict | None) -> bool:
+    """Whether the run takes the sensed path (:mod:`tmem.engine.sensed`); what that path cannot do is
+    refused in one line (the schema refuses it in a scenario; this, given ``overrides``)."""
+    sensed = overrides is not None or not settings.exact
+    if sensed and run.use_lists and settings.range is None:
+        raise ValueError("sensing.range: is required when neighbours are found with lists: the lists hold the agents within range")
+    if sensed and scenario.gas_observed:
+        raise ValueError("sensing: the gas's stages read exact states: a run with sensing effects cannot observe its gas")
+    return sensed
+
+
 def _run_of(scenario: Scenario, initial: InitialArrays, record: bool) -> Run:
     """What stays fixed over the run: steps, recording, the box, the kind of neighbour list."""
     sim = scenario.simulation
     n_agents = initial.state.shape[0]
-    method = scenario.neighbors.method
-    use_lists = method == "verlet" or (method == "auto" and n_agents >= LARGE_SWARM)
+    use_lists = scenario.neighbors.uses_lists(n_agents)
     box = tuple(initial.box.tolist())
     return Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
 

@@ -33,7 +33,13 @@ from .records import DONE, LISTS_STALE
 from ..control import tilt_scale
 from .gas import gas_pushes, tally, tilt_limit
 from .pairs import formation_pairs
+from .sensed import sensed_formation_pairs, sensed_neighbour_pushes
 from .stages import apply_commands, commands_due, corrected_positions, is_recorded, neighbour_pushes, record
+
+#: Whether the loop takes the sensed path (:mod:`tmem.engine.sensed`); bound for each compiled copy by
+#: :func:`advance_for`.  Numba prunes the branch not taken before it types the loop, so the exact
+#: copy is compiled as if the sensed stages did not exist.
+SENSED = False
 
 
 def vehicle_step(x, body, u, i, scale, params, n_axes):
@@ -55,7 +61,9 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
 
     Each step: commands -> measurement -> P* (6) -> neighbour pushes -> formation pairs -> thermostat,
     walls and obstacles (when the gas is observed) -> record -> saturate the set-point and step the
-    vehicles (held over ``dt``)."""
+    vehicles (held over ``dt``).  On the sensed path each agent measures, and pushes from what it
+    measured."""
+    listed = 1 if SENSED else 0  # the lists hold P* (6); with sensing, P (the range is one of positions)
     box = run.box
     n_axes = len(box)
     c_max = params.c_max
@@ -69,19 +77,25 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
         rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters, gas)
-        known = measure(x, sensing)
-        moved2 = corrected_positions(known, agents, law, run, neighbours, gas)
+        known = x
+        if SENSED:
+            known = measure(k, x, sensing)
+        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, listed)
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
             for i in range(x.shape[0]):
                 for a in range(n_axes):
-                    neighbours.p_ref[i, a] = agents.corrected[i, a, 0]
+                    neighbours.p_ref[i, a] = agents.corrected[i, a, listed]
             return LISTS_STALE
-        neighbour_pushes(agents, neighbours, law, params, run, gas)
-        formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas)
+        if SENSED:
+            sensed_neighbour_pushes(k, agents, neighbours, law, params, run, sensing)
+            sensed_formation_pairs(k, agents, pairs, law, params, run, events, counters, sensing)
+        else:
+            neighbour_pushes(agents, neighbours, law, params, run, gas)
+            formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas)
         if gas.observe:
             gas_pushes(known, agents, gas, wall_params, run)
         if is_recorded(k, run):
-            record(agents, pairs, records, c_max, run, counters, gas)
+            record(agents, pairs, records, c_max, run, counters, gas, SENSED)
         if k < run.n_steps:
             for i in numba.prange(x.shape[0]):
                 if active[i]:
@@ -97,7 +111,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
 
 
 @cache
-def advance_for(model_class, threaded: bool):
+def advance_for(model_class, threaded: bool, sensed: bool = False):
     """The compiled loop of a vehicle model (a :class:`tmem.model.base.VehicleModel` subclass).
 
     Parameters
@@ -106,9 +120,11 @@ def advance_for(model_class, threaded: bool):
         Its ``step`` kernel is bound to ``vehicle_step``; its ``kind`` names the copy.
     threaded
         Per-agent stages and blocks of neighbour sums on threads (large swarms).
+    sensed
+        The sensed path (:mod:`tmem.engine.sensed`): a copy of its own, named ``..._sensed``.
     """
-    name = f"_advance_{model_class.kind}_{'threaded' if threaded else 'serial'}"
-    namespace = dict(_advance_source.__globals__, vehicle_step=model_class.step)
+    name = f"_advance_{model_class.kind}_{'threaded' if threaded else 'serial'}{'_sensed' if sensed else ''}"
+    namespace = dict(_advance_source.__globals__, vehicle_step=model_class.step, SENSED=sensed)
     source = types.FunctionType(_advance_source.__code__, namespace, name)
     source.__qualname__ = name
     return numba.njit(cache=True, parallel=threaded, error_model="numpy", _nrt=False)(source)

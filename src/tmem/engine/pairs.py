@@ -63,12 +63,25 @@ def _next_flag(k, e, r, energy, pairs, law, params):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
-    """Add pair ``e``'s push to its agents, equal and opposite: (10)/(11) along ``d / |d|``, or, while
-    coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)`` saturated on its norm.
-    On return ``d`` holds the push on agent ``i``."""
-    i = pairs.i[e]
-    j = pairs.j[e]
+def pair_push(e, d, r, pairs, law, params, n_axes):
+    """Pair ``e``'s push on its agent ``i``, in place of ``d = P*_j - P*_i`` (``|d| = r``): (10)/(11) along
+    ``d / |d|``, or, while coupled with a direction to hold ``b``, the vector spring ``K_P (d - d_t b)``
+    saturated on its norm.  Agent ``j``'s push is its opposite.
+
+    Parameters
+    ----------
+    e : int
+        The pair.
+    d : ndarray, shape (axes,)
+        ``P*_j - P*_i`` on entry, the push on ``i`` (rad) on return.
+    r : float
+        ``|d|`` (m).
+    pairs, law
+        The loop's records (:mod:`tmem.engine.records`).
+    params : FunctionParams
+        The interaction functions' parameters; the pair's own ``d_t`` replaces the scenario's.
+    n_axes : int
+    """
     if pairs.flag[e] == 1 and not np.isnan(pairs.direction[e, 0]):
         norm2 = 0.0
         for a in range(n_axes):
@@ -80,20 +93,39 @@ def _pair_pull(e, d, r, pairs, law, params, n_axes, u):
         push = pair_control(law.function, r, pairs.flag[e], p) / r if r > 0.0 else 0.0
     for a in range(n_axes):
         d[a] *= push
-        u[i, a] += d[a]
-        u[j, a] -= d[a]
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _synchronise(e, r, dist, entering, pushed, known, pairs, law, params, n_axes, u):
+def synchronise(e, i, j, r, dist, entering, pushed, known, pairs, law, params, n_axes, u):
     """(S2) on pair ``e``: from its coupling, its relative motion damped and its mean square speed held
     at its value when it came within reach; after it uncouples, the speed alone, until it is out of
-    reach again (:mod:`tmem.synchronise`).  ``pushed``: the pair's push on agent ``i`` this step.
+    reach again (:mod:`tmem.synchronise`).
 
     Called, not inlined, and only where a scenario synchronises: inlined in the step loop it made the
-    first run's compilation a third longer for every scenario."""
-    i = pairs.i[e]
-    j = pairs.j[e]
+    first run's compilation a third longer for every scenario.
+
+    Parameters
+    ----------
+    e : int
+        The pair.
+    i, j : int
+        The rows of its two agents in ``known`` and ``u``.
+    r, dist : float
+        ``|d|`` and ``|P_j - P_i|`` (m).
+    entering : bool
+        Whether the pair came within reach at this step.
+    pushed : ndarray, shape (axes,)
+        The pair's push on agent ``i`` this step (rad).
+    known : ndarray, shape (rows, axes, n_state)
+        The states as measured.
+    pairs, law
+        The loop's records; ``pairs`` changes in place.
+    params : FunctionParams
+        The interaction functions' parameters.
+    n_axes : int
+    u : ndarray, shape (rows, axes)
+        The set-points the pushes are added to.
+    """
     if entering:
         pairs.entry_speed2[e] = mean_square_speed(known, i, j, n_axes)
     coupled = pairs.flag[e] == 1
@@ -136,16 +168,65 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
     n_axes = len(box)
     i = pairs.i[e]
     j = pairs.j[e]
-    if not (agents.active[i] and agents.active[j]):
-        if pairs.flag[e] == 1:  # the pair is lost with its agent
-            pairs.flag[e] = 0
-            pairs.kept_speed2[e] = np.nan
-            log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1, coupling.RELEASE_LOST)
-        pairs.r_before[e] = np.nan
+    if released_if_lost(k, e, agents, pairs, events, counters):
         return
     r, dist = _pair_geometry(agents.corrected, e, pairs, box, d)
     if dist < pairs.min_distance[e]:
         pairs.min_distance[e] = dist
+    entering = check_flag(k, e, r, d, known, i, j, pairs, law, params, n_axes, events, counters)
+    pair_push(e, d, r, pairs, law, params, n_axes)
+    for a in range(n_axes):
+        agents.setpoint[i, a] += d[a]
+        agents.setpoint[j, a] -= d[a]
+    if law.sync_gain > 0.0:
+        synchronise(e, i, j, r, dist, entering, d, known, pairs, law, params, n_axes, agents.setpoint)
+
+
+@numba.njit(cache=True, inline="always")
+def released_if_lost(k, e, agents, pairs, events, counters):
+    """Whether pair ``e`` has lost an agent (removed); a coupled pair then uncouples and rests.
+
+    Parameters
+    ----------
+    k, e : int
+        The step and the pair.
+    agents, pairs, events, counters
+        The loop's records; all but ``agents`` change in place.
+    """
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if agents.active[i] and agents.active[j]:
+        return False
+    if pairs.flag[e] == 1:  # the pair is lost with its agent
+        pairs.flag[e] = 0
+        pairs.kept_speed2[e] = np.nan
+        log_event(events, counters, k, coupling.EVENT_UNCOUPLE, i, j, -1, coupling.RELEASE_LOST)
+    pairs.r_before[e] = np.nan
+    return True
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def check_flag(k, e, r, d, known, i, j, pairs, law, params, n_axes, events, counters):
+    """Pair ``e``'s flag after step ``k``'s check ((9), or the energy match), an event where it changes;
+    ``r`` becomes the pair's ``|d|`` one step earlier.  Returns whether the pair came within reach.
+
+    Parameters
+    ----------
+    k, e : int
+        The step and the pair.
+    r : float
+        ``|d|`` this step (m).
+    d : ndarray, shape (axes,)
+        ``P*_j - P*_i``.
+    known : ndarray, shape (rows, axes, n_state)
+        The states as measured; ``i`` and ``j`` are the rows of the pair's agents.
+    i, j : int
+    pairs, law, events, counters
+        The loop's records; ``pairs``, ``events`` and ``counters`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters.
+    n_axes : int
+    """
     if law.couples:
         energy = 0.0  # needed by the energy rule only
         if law.uncouple_rule == coupling.UNCOUPLE_BY_ENERGY and r > 0.0:
@@ -153,12 +234,11 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
         new, released_by = _next_flag(k, e, r, energy, pairs, law, params)
         if new != pairs.flag[e]:
             pairs.flag[e] = new
-            log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE, i, j, -1, released_by)
+            log_event(events, counters, k, coupling.EVENT_COUPLE if new == 1 else coupling.EVENT_UNCOUPLE,
+                      pairs.i[e], pairs.j[e], -1, released_by)  # fmt: skip
     entering = r < params.reach and not pairs.r_before[e] < params.reach  # or at the first step
     pairs.r_before[e] = r
-    _pair_pull(e, d, r, pairs, law, params, n_axes, agents.setpoint)
-    if law.sync_gain > 0.0:
-        _synchronise(e, r, dist, entering, d, known, pairs, law, params, n_axes, agents.setpoint)
+    return entering
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)

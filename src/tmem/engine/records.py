@@ -103,7 +103,8 @@ class Agents(NamedTuple):
     active : ndarray, shape (agents,), bool
         Flying; a removed agent stops where it is and no longer interacts.
     corrected : ndarray, shape (agents, axes, 2)
-        ``(P*, P)`` on each axis, as the agent's neighbours measure it.
+        ``(P*, P)`` on each axis: ``P*`` as the agent knows itself (:mod:`tmem.sensing`; exact
+        without sensing effects), ``P`` true.
     setpoint : ndarray, shape (agents, axes)
         The sum of pushes ``U`` of this step, before saturation.
     body : ndarray, shape (agents, n_body)

@@ -6,7 +6,8 @@ of :mod:`tmem.engine.records` in place.  Nothing is allocated at a step: the
 work space comes in the records.
 
 1. :func:`apply_commands` — operator commands due at the step (:func:`commands_due`);
-2. measurement (:func:`tmem.sensing.measure`) — the states as each agent knows them;
+2. measurement (:func:`tmem.sensing.measure`) — the states as each agent knows them (the
+   sensed path, :mod:`tmem.engine.sensed`, takes the place of steps 4 and 5);
 3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
    lists have drifted;
 4. :func:`neighbour_pushes` — the pushes of the non-formation neighbours;
@@ -135,19 +136,24 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def corrected_positions(known, agents, law, run, neighbours, gas):
-    """``P* = x . K / K_P`` (6) and ``P`` of every agent into ``agents.corrected``; clear the set-points
-    (and, when the gas is observed, its counts: :func:`tmem.engine.gas.clear`).
+def corrected_positions(known, agents, law, run, neighbours, gas, listed):
+    """``P* = x . K / K_P`` (6) of every agent as it knows itself, and its true ``P``, into
+    ``agents.corrected``; clear the set-points (and, when the gas is observed, its counts:
+    :func:`tmem.engine.gas.clear`).
 
-    Returns the largest squared shift of a flying agent's ``P*`` since the lists were built (0
-    without lists).
+    Returns the largest squared shift of a flying agent's listed point (``P*``, or ``P`` with sensing)
+    since the lists were built (0 without lists).
 
     Parameters
     ----------
     known : ndarray, shape (agents, axes, n_state)
-        The states as measured (:func:`tmem.sensing.measure`).
+        Each agent's own state as it measures it (:func:`tmem.sensing.measure`; the true states when
+        exact).
     agents, law, run, neighbours, gas
         The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.
+    listed : int
+        What the lists hold: 0, ``P*`` (the exact path), or 1, ``P`` (the sensed path, whose range
+        is one of positions).
     """
     box = run.box
     observe = gas.observe
@@ -157,6 +163,7 @@ def corrected_positions(known, agents, law, run, neighbours, gas):
     n_axes = len(box)
     use_lists = run.use_lists
     gains = law.gains
+    state = agents.state
     corrected = agents.corrected
     setpoint = agents.setpoint
     active = agents.active
@@ -171,10 +178,10 @@ def corrected_positions(known, agents, law, run, neighbours, gas):
             shift2 = 0.0
             for a in range(n_axes):
                 corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains, i)
-                corrected[i, a, 1] = known[i, a, 0]
+                corrected[i, a, 1] = state[i, a, 0]
                 setpoint[i, a] = 0.0  # the sum of pushes starts here
                 if use_lists:
-                    delta = nearest_image(corrected[i, a, 0] - p_ref[i, a], box[a])
+                    delta = nearest_image(corrected[i, a, listed] - p_ref[i, a], box[a])
                     shift2 += delta * delta
             if observe:
                 clear(i, known, work, kept, c_max, n_axes)
@@ -326,7 +333,7 @@ def is_recorded(k, run):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def record(agents, pairs, records, c_max, run, counters, gas):
+def record(agents, pairs, records, c_max, run, counters, gas, sensed):
     """Record the step, before the vehicles move, with the saturated set-point applied over it.
 
     Parameters
@@ -335,6 +342,9 @@ def record(agents, pairs, records, c_max, run, counters, gas):
         The loop's records (:mod:`tmem.engine.records`); ``records`` and ``counters`` change in place.
     c_max : float
         Tilt limit (rad).
+    sensed : bool
+        The sensed path: a pair's ``|d|`` is the one its first agent measured (``pairs.r_before``;
+        NaN where it measured none), not the one of the true states.
     """
     n_axes = len(run.box)
     q_record = counters.next_record[0]
@@ -359,6 +369,6 @@ def record(agents, pairs, records, c_max, run, counters, gas):
             delta = nearest_image(agents.corrected[pairs.j[e], a, 0] - agents.corrected[pairs.i[e], a, 0], run.box[a])
             r2 += delta * delta
         records.distance[q_record, e] = np.sqrt(dist2)
-        records.measure[q_record, e] = np.sqrt(r2)
+        records.measure[q_record, e] = pairs.r_before[e] if sensed else np.sqrt(r2)
     record_totals(agents, gas, records, q_record, n_axes)
     counters.next_record[0] = q_record + 1

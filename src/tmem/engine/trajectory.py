@@ -59,12 +59,14 @@ class Trajectory:
     pair_distance : ndarray, shape (n_records, n_pairs)
         ``|P_j - P_i|`` of each pair (nearest image).
     interaction_distance : ndarray, shape (n_records, n_pairs)
-        ``|d| = |P*_j - P*_i|`` (6) of each pair.
+        ``|d| = |P*_j - P*_i|`` (6) of each pair; with sensing effects, as the pair's first agent
+        measured it (NaN where it measured nothing: :mod:`tmem.engine.sensed`).
     min_distance : ndarray, shape (n_pairs,)
         Smallest distance of each formation pair over every step.
     min_neighbor_distance : float
         Smallest distance between any two agents within ``R + R_j`` of each
-        other (in ``P*``) at any step; ``inf`` if no two came so close.
+        other (in ``P*``; with sensing effects, as one of them measured) at any
+        step; ``inf`` if no two came so close.
     final_state : ndarray, shape (agents, axes, 4)
         Every agent's state at the end.
     final_active : ndarray, shape (agents,), bool

@@ -9,11 +9,13 @@ message naming the field and the reason.  Defaults are documented in
 
 * :mod:`~tmem.scenario.tables` — one pydantic model per table, and the number types;
 * :mod:`~tmem.scenario.schema` — :class:`Scenario`, the tables checked against each other;
+* :mod:`~tmem.scenario.sensing_table` — the ``[sensing]`` table and its checks against the scenario;
 * :mod:`~tmem.scenario.files` — reading, writing and editing files; the presets.
 """
 
 from .files import PRESETS, describe, from_dict, load, loads, preset, read_text, with_changes
 from .schema import MAX_AGENTS_ALL_PAIRS, MAX_RECORD_BYTES, TRACK_ALL_PAIRS, Scenario
+from .sensing_table import SensingParams
 from .tables import (
     LIMIT,
     MODEL_KINDS,
@@ -67,6 +69,7 @@ __all__ = [
     "QuadrotorModelParams",
     "Scenario",
     "ScenarioError",
+    "SensingParams",
     "SimulationParams",
     "SpaceParams",
     "StrictModel",

@@ -3,7 +3,8 @@
 A scenario is a TOML file with the tables ``[model]`` (Table 1),
 ``[controller]`` (roots (5)), ``[interaction]``, ``[simulation]``,
 ``[[agents]]`` (Table 2) and ``[[commands]]``, and optionally ``[space]``,
-``[neighbors]``, ``[formation]`` and ``[swarm]`` (:mod:`tmem.scenario.tables`).
+``[neighbors]``, ``[formation]``, ``[swarm]`` and ``[sensing]`` (:mod:`tmem.scenario.tables`,
+:mod:`tmem.scenario.sensing_table`).
 Every key is checked: unknown keys, non-finite numbers and values out of range
 are refused; :func:`tmem.scenario.files.describe` turns the errors into the one
 line of a :class:`ScenarioError`.  Defaults are documented in
@@ -41,6 +42,7 @@ from .tables import (
     ThermostatParams,
     per_axis,
 )
+from .sensing_table import SensingParams, check_sensing
 
 #: Most bytes a run may set aside for its records.
 MAX_RECORD_BYTES = 8 * 2**30
@@ -103,6 +105,7 @@ class Scenario(StrictModel):
     swarm: SwarmParams | None = None
     thermostat: ThermostatParams | None = None
     coverage: CoverageParams | None = None
+    sensing: SensingParams | None = None
     obstacles: list[Obstacle] = []
     agents: list[Agent] = []
     commands: list[Command] = []
@@ -206,6 +209,7 @@ class Scenario(StrictModel):
                 if not 0 <= a < n:
                     raise FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
         self._check_memory(n)  # before generating anything
+        check_sensing(self, n, self.neighbors.uses_lists(n), memory_limit())
         pairs = self.pairs()  # generating a large formation is not free: once per validation
         if self.simulation.record_agents == [] and not len(pairs):
             raise FieldError(

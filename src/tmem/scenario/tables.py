@@ -2,7 +2,8 @@
 
 ``[model]`` (Table 1), ``[controller]`` (roots (5)), ``[interaction]`` (7)-(11),
 ``[simulation]``, ``[space]``, ``[neighbors]``, ``[formation]``, ``[swarm]``,
-``[thermostat]``, ``[coverage]``, ``[[obstacles]]``, ``[[agents]]`` (Table 2) and ``[[commands]]``.  Each table checks its own keys;
+``[thermostat]``, ``[coverage]``, ``[[obstacles]]``, ``[[agents]]`` (Table 2) and ``[[commands]]``
+(``[sensing]`` has a module of its own, :mod:`tmem.scenario.sensing_table`).  Each table checks its own keys;
 :mod:`tmem.scenario.schema` checks them against each other.  A check that
 spans fields raises :class:`FieldError` naming the field at fault.
 """
@@ -295,11 +296,25 @@ class ThermostatParams(StrictModel):
     tau: Annotated[float, Field(gt=0, le=LIMIT)] = 5.0
 
 
+#: Swarms at least this large find their neighbours with Verlet lists under ``method = "auto"``.
+LARGE_SWARM = 64
+
+
 class NeighborParams(StrictModel):
     """Neighbour search: every pair, or Verlet lists built from cells with a skin."""
 
     method: Literal["auto", "all", "verlet"] = "auto"
     skin: Positive = 4.0
+
+    def uses_lists(self, n_agents: int) -> bool:
+        """Whether a swarm of ``n_agents`` finds its neighbours with lists (else it takes every pair).
+
+        Parameters
+        ----------
+        n_agents : int
+            The number of agents.
+        """
+        return self.method == "verlet" or (self.method == "auto" and n_agents >= LARGE_SWARM)
 
 
 class FormationParams(StrictModel):
