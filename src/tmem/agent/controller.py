@@ -97,6 +97,14 @@ class AgentController:
     ------
     ControllerError
         One line naming the field at fault.
+
+    Attributes
+    ----------
+    settings : ControllerSettings
+        What it was built from, checked.
+    events : list of Event
+        What happened, as :class:`tmem.Event`: the commands it carried out, and its edges'
+        couplings and uncouplings (agents named by id, the lower first).
     """
 
     def __init__(self, agent: int, gains, *, dt: float, axes: int = 1, function: str = DEFAULTS.function,
@@ -105,7 +113,7 @@ class AgentController:
                  energy_tolerance: float = DEFAULTS.energy_tolerance, fallback_time: float | None = None,
                  sync_gain: float = 0.0, edges: Sequence[Edge] = (), commands: Sequence[OperatorCommand] = (),
                  order: Sequence[int] | None = None, max_age: float | None = None):  # fmt: skip
-        gains = list(gains) if isinstance(gains, Iterable) and not isinstance(gains, str | dict) else gains
+        gains = list(gains) if isinstance(gains, Iterable) else gains
         self.settings = ControllerSettings(
             agent=agent, gains=gains, dt=dt, axes=axes, function=function, reach=reach, c_max=c_max, d_t=d_t, eps=eps,
             switch_at=switch_at, uncouple_when=uncouple_when, energy_tolerance=energy_tolerance,
@@ -158,20 +166,17 @@ class AgentController:
         """Back to the start: each edge's flag as given, armed, with nothing remembered; no command
         carried out yet; no events."""
         s = self.settings
-        edges = s.edges
-        start = {"i": [min(s.agent, e.neighbour) for e in edges], "j": [max(s.agent, e.neighbour) for e in edges],
-                 "flag": [int(e.coupled) for e in edges], "armed": 1, "disarmed_at": 0}  # fmt: skip
-        row_of = {s.agent: 0, **self._row}
-        start["i"], start["j"] = [row_of[n] for n in start["i"]], [row_of[n] for n in start["j"]]
+        lower = [s.agent < edge.neighbour for edge in s.edges]  # the pair's i is the lower id: row 0 or the edge's
+        start = {"i": [0 if low else e + 1 for e, low in enumerate(lower)], "j": [e + 1 if low else 0 for e, low in enumerate(lower)],
+                 "flag": [int(edge.coupled) for edge in s.edges], "armed": 1, "disarmed_at": 0}  # fmt: skip
         for row, name in enumerate(PAIR_INTS):
             self._pair_ints[row] = start[name]
         self._pair_floats[:] = np.nan
-        self._pair_floats[PAIR_FLOATS.index("d_t")] = [s.d_t if e.d_t is None else e.d_t for e in edges]
+        self._pair_floats[PAIR_FLOATS.index("d_t")] = [s.d_t if edge.d_t is None else edge.d_t for edge in s.edges]
         self._pair_floats[PAIR_FLOATS.index("min_distance")] = np.inf
-        for e, edge in enumerate(edges):  # held from i to j: the edge gives it from this agent
+        for e, (edge, low) in enumerate(zip(s.edges, lower)):  # held from i to j; the edge gives it from this agent
             if edge.direction is not None:
-                sign = 1.0 if s.agent < edge.neighbour else -1.0
-                self._direction[e] = [sign * b for b in edge.direction]
+                self._direction[e] = [b if low else -b for b in edge.direction]
         self._next_command = 0
         self.events: list[Event] = []
 
