@@ -209,7 +209,8 @@ def test_bad_tables_and_update_input_are_refused_in_one_line():
     for call, field in [(lambda: controllers[0].update(np.zeros((2, 4)), [], 0.0), "own_state"),
                         (lambda: controllers[0].update(np.full((1, 4), np.inf), [], 0.0), "own_state"),
                         (lambda: controllers[0].update(states[0], [], -1.0), "t: "),
-                        (lambda: controllers[0].update(states[0], [AgentMessage(1, 0.0, True, np.zeros((3, 2)))], 0.0), "messages"),
+                        (lambda: controllers[0].update(states[0], [AgentMessage(1, 0.0, True, np.zeros((3, 2)))], 0.0),
+                         "messages"),
                         (lambda: controllers[0].flag(5), "neighbour")]:  # fmt: skip
         with pytest.raises(ControllerError, match=field):
             call()
@@ -223,7 +224,8 @@ REFUSED = [
     (with_changes(tmem.load(EXAMPLES / "swarm/triangle.toml"), {"interaction.combine": "mean"}), "interaction.combine"),
     (GAS_BOX, "swarm.n"),
     (tmem.load(EXAMPLES / "swarm/ring8_loss.toml"), "commands[0].action"),
-    (with_changes(tmem.preset("fig9"), {"agents": [{"position": 50.0}, {"position": 0.0, "active": False}]}), "agents[1].active"),
+    (with_changes(tmem.preset("fig9"), {"agents": [{"position": 50.0}, {"position": 0.0, "active": False}]}),
+     "agents[1].active"),
 ]
 
 

@@ -101,10 +101,11 @@ def fly_nodes(scenario: tmem.Scenario) -> list[SimulatedVehicle]:
         if k < scenario.simulation.n_steps:
             for vehicle in vehicles:
                 vehicle.advance()
-    for node in nodes:
-        for event in node.controller.events:
-            if event.kind != "command" and event.agents[0] == node.controller.agent:
-                print(f"  t = {event.time:7.3f} s  pair {event.agents}: {event.kind}" + (f" ({event.rule})" if event.rule else ""))
+    # Both agents of a pair log its couplings; the first agent's log is printed.
+    logged = [e for node in nodes for e in node.controller.events if e.kind != "command" and e.agents[0] == node.controller.agent]
+    for event in sorted(logged, key=lambda e: e.time):
+        rule = f" ({event.rule})" if event.rule else ""
+        print(f"  t = {event.time:7.3f} s  pair {event.agents}: {event.kind}{rule}")
     return vehicles
 
 
@@ -116,7 +117,8 @@ def main() -> None:
     scenario = tmem.load(args.scenario)
     commands = [c.model_dump(exclude_none=True) for c in scenario.commands if c.time <= args.duration]
     scenario = with_changes(scenario, {"simulation.duration": args.duration, "commands": commands})
-    print(f"{scenario.name or args.scenario}: {scenario.n_agents} agents, {scenario.simulation.n_steps} ticks of {scenario.simulation.dt:g} s")
+    sim = scenario.simulation
+    print(f"{scenario.name or args.scenario}: {scenario.n_agents} agents, {sim.n_steps} ticks of {sim.dt:g} s")
     vehicles = fly_nodes(scenario)
     final = np.array([v.state[0] for v in vehicles])
     engine = tmem.simulate(scenario).final_state

@@ -128,7 +128,8 @@ class AgentController:
         s = self.settings
         self._gains = np.array(s.gains, dtype=float)[np.newaxis, :]
         fallback = 0 if s.fallback_time is None else int(round(s.fallback_time / s.dt))
-        law = law_record(self._gains[0], s.function, s.switch_at, s.eps, s.uncouple_when, s.energy_tolerance, fallback, s.sync_gain)
+        law = law_record(self._gains[0], s.function, s.switch_at, s.eps, s.uncouple_when, s.energy_tolerance, fallback,
+                         s.sync_gain)  # fmt: skip
         self._law = law_tables(law, FunctionParams(self._gains[0, 0], s.reach, s.d_t, s.c_max))
         self._ids = np.array([s.agent] + [edge.neighbour for edge in s.edges], dtype=np.int64)
         self._row = {int(n): row for row, n in enumerate(self._ids) if row > 0}
@@ -167,8 +168,9 @@ class AgentController:
         carried out yet; no events."""
         s = self.settings
         lower = [s.agent < edge.neighbour for edge in s.edges]  # the pair's i is the lower id: row 0 or the edge's
-        start = {"i": [0 if low else e + 1 for e, low in enumerate(lower)], "j": [e + 1 if low else 0 for e, low in enumerate(lower)],
-                 "flag": [int(edge.coupled) for edge in s.edges], "armed": 1, "disarmed_at": 0}  # fmt: skip
+        rows = [(0, e + 1) if low else (e + 1, 0) for e, low in enumerate(lower)]
+        start = {"i": [i for i, _ in rows], "j": [j for _, j in rows], "flag": [int(edge.coupled) for edge in s.edges],
+                 "armed": 1, "disarmed_at": 0}  # fmt: skip
         for row, name in enumerate(PAIR_INTS):
             self._pair_ints[row] = start[name]
         self._pair_floats[:] = np.nan
@@ -246,7 +248,8 @@ class AgentController:
     def _own(self, own_state) -> np.ndarray:
         own = np.ascontiguousarray(own_state, dtype=float)
         if own.shape[0] != self.settings.axes or own.ndim != 2 or own.shape[1] < 4:
-            raise ControllerError(f"own_state: needs shape ({self.settings.axes}, 4), (P, V, phi, omega) per axis, got {own.shape}")
+            axes = self.settings.axes
+            raise ControllerError(f"own_state: needs shape ({axes}, 4), (P, V, phi, omega) per axis, got {own.shape}")
         if not np.isfinite(own).all():
             raise ControllerError("own_state: every number must be finite")
         return own

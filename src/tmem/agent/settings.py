@@ -158,7 +158,8 @@ class ControllerSettings(_Checked):
         if self.eps >= self.d_t:
             raise FieldError("eps", f"must be less than d_t = {self.d_t:g} m, got {self.eps:g}")
         if self.uncouple_when == "energy" and self.fallback_time is None:
-            raise FieldError("fallback_time", "is required with uncouple_when = 'energy' (one period of the coupled pair's slow mode)")
+            raise FieldError("fallback_time", "is required with uncouple_when = 'energy' "
+                             "(one period of the coupled pair's slow mode)")  # fmt: skip
         self._check_edges()
         self._check_commands()
         if self.order is not None and len(set(self.order)) != len(self.order):
@@ -176,10 +177,11 @@ class ControllerSettings(_Checked):
             if edge.d_t is not None and edge.d_t >= self.reach:
                 raise FieldError(f"edges[{k}].d_t", f"must be less than reach = {self.reach:g} m, got {edge.d_t:g}")
             if edge.direction is not None:
+                where, length = f"edges[{k}].direction", math.hypot(*edge.direction)
                 if len(edge.direction) != self.axes:
-                    raise FieldError(f"edges[{k}].direction", f"needs {self.axes} values, one per axis, got {len(edge.direction)}")
-                if abs(math.hypot(*edge.direction) - 1.0) > UNIT_TOLERANCE:
-                    raise FieldError(f"edges[{k}].direction", f"must be a unit vector, got length {math.hypot(*edge.direction):g}")
+                    raise FieldError(where, f"needs {self.axes} values, one per axis, got {len(edge.direction)}")
+                if abs(length - 1.0) > UNIT_TOLERANCE:
+                    raise FieldError(where, f"must be a unit vector, got length {length:g}")
 
     def _check_commands(self) -> None:
         for k, command in enumerate(self.commands):
