@@ -86,23 +86,51 @@ def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gai
     FunctionParams
     """
     ia = scenario.interaction
-    couples = uses_coupling(ia.function)
     sync_gain = synchronising_gain(*linearisation, gains, ia.sync_damping) if ia.synchronise else 0.0
     slow = coupled_mode(*linearisation, gains, sync_gain)
     period = 2.0 * np.pi / abs(slow.imag) if slow.imag != 0.0 else 1.0 / abs(slow.real)
-    law = Law(
-        gains=gains[np.newaxis, :],
-        function=code(ia.function),
-        neighbour_function=code("repulsion") if couples else code(ia.function),
+    law = law_record(gains, ia.function, ia.switch_at, ia.eps, ia.uncouple_when, ia.energy_tolerance,
+                     scenario.simulation.step_of(period), sync_gain)  # fmt: skip
+    return law, FunctionParams(gains[0], ia.reach, ia.d_t, ia.c_max)
+
+
+def law_record(gains: np.ndarray, function: str, switch_at: str, eps: float, uncouple_when: str, energy_tolerance: float,
+               fallback_steps: int, sync_gain: float) -> Law:  # fmt: skip
+    """The :class:`~tmem.engine.records.Law` of agents that share the gains ``gains``, from the names
+    and numbers of an ``[interaction]`` table.
+
+    Parameters
+    ----------
+    gains : ndarray, shape (4,)
+        ``K`` (:func:`tmem.control.gains_for`).
+    function : str
+        The interaction function's name (:data:`tmem.interaction.registry.FUNCTION_NAMES`); the
+        other neighbours push with it too, or with the repulsion (8) if it switches on ``F_en``.
+    switch_at, uncouple_when : str
+        Where the flag flips (``"window"`` or ``"crossing"``) and the uncoupling rule
+        (``"window"`` or ``"energy"``), :mod:`tmem.coupling`.
+    eps : float
+        The coupling window of (9) (m).
+    energy_tolerance : float
+        The energy rule's relative tolerance.
+    fallback_steps : int
+        Steps after an uncouple command when the energy rule falls back on (9).
+    sync_gain : float
+        ``k_s`` of (S2) (rad per m/s); 0: no synchronisation.
+    """
+    couples = uses_coupling(function)
+    return Law(
+        gains=np.asarray(gains, dtype=float)[np.newaxis, :],
+        function=code(function),
+        neighbour_function=code("repulsion") if couples else code(function),
         couples=couples,
-        at_crossing=ia.switch_at == "crossing",
-        eps=ia.eps,
-        uncouple_rule=coupling.UNCOUPLE_RULES.index(ia.uncouple_when),
-        energy_tolerance=ia.energy_tolerance,
-        fallback_steps=scenario.simulation.step_of(period),
+        at_crossing=switch_at == "crossing",
+        eps=eps,
+        uncouple_rule=coupling.UNCOUPLE_RULES.index(uncouple_when),
+        energy_tolerance=energy_tolerance,
+        fallback_steps=fallback_steps,
         sync_gain=sync_gain,
     )
-    return law, FunctionParams(gains[0], ia.reach, ia.d_t, ia.c_max)
 
 
 def _commands(scenario: Scenario, edges: np.ndarray, slot: np.ndarray) -> Commands:
@@ -192,7 +220,20 @@ def _events(capacity: int) -> Events:
     return Events(*(np.empty(capacity, dtype=np.int64) for _ in Events._fields))
 
 
-def _read_events(events: Events, n_events: int, order: np.ndarray, dt: float) -> list[Event]:
+def read_events(events: Events, n_events: int, order: np.ndarray, dt: float) -> list[Event]:
+    """The first ``n_events`` events of a loop's record, with agents named by ``order[slot]``.
+
+    Parameters
+    ----------
+    events : Events
+        The record the loop logged them in (:func:`tmem.engine.stages.log_event`).
+    n_events : int
+        How many it logged.
+    order : ndarray
+        The agent in each slot.
+    dt : float
+        The time step (s): an event at step ``k`` happened at ``k dt``.
+    """
     found = []
     for e in range(n_events):
         kind = coupling.EVENT_KINDS[events.kind[e]]
@@ -220,13 +261,30 @@ class _Slots:
     steps: np.ndarray  # the recorded steps
 
 
+def slot_order(scenario: Scenario, initial: InitialArrays, gains: np.ndarray) -> np.ndarray:
+    """The agent in each slot of a run: a spatial order of the starting ``P*`` (6).
+
+    Each agent adds its neighbours' pushes in this order (:func:`tmem.neighbors.arrange`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its reach and skin set the cells.
+    initial : InitialArrays
+        The starting states, flying agents and box.
+    gains : ndarray, shape (4,)
+        ``K`` of every agent.
+    """
+    cell = scenario.interaction.reach + scenario.neighbors.skin
+    return spatial_order(interaction_point(initial.state, gains), initial.active, cell, initial.box)
+
+
 def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, record: bool, body: np.ndarray) -> _Slots:
     """The records of a run, its agents placed in a spatial order of their ``P*`` (6); ``body`` the
     agents' body states at the start (by agent number)."""
     sim = scenario.simulation
     n_agents, n_axes, n_state = initial.state.shape
-    cell = scenario.interaction.reach + scenario.neighbors.skin
-    order = spatial_order(interaction_point(initial.state, gains), initial.active, cell, initial.box)
+    order = slot_order(scenario, initial, gains)
     slot = np.empty(n_agents, dtype=np.int64)
     slot[order] = np.arange(n_agents)
     x = initial.state[order]
@@ -324,7 +382,7 @@ def simulate(
         min_neighbor_distance=float(np.sqrt(lister.closest[0])),
         final_state=x[swarm.slot],
         final_active=swarm.agents.active[swarm.slot],
-        events=_read_events(swarm.events, int(swarm.counters.n_events[0]), swarm.order, sim.dt),
+        events=read_events(swarm.events, int(swarm.counters.n_events[0]), swarm.order, sim.dt),
         list_builds=lister.builds,
         gas=swarm.records.gas,
         body=swarm.records.body,

@@ -28,7 +28,7 @@ import numpy as np
 
 from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
 from ..control import corrected_position, tilt_scale
-from ..interaction.kernels import FunctionParams, pair_control
+from ..interaction.kernels import FunctionParams, push_factor
 from ..space import nearest_image
 from .gas import add_contact, clear, pair_share, record_totals, tilt_limit
 from .records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
@@ -81,6 +81,27 @@ def commands_due(k, commands, counters):
     return c < commands.step.shape[0] and commands.step[c] <= k
 
 
+@numba.njit(cache=True, inline="always")
+def command_pair(k, e, kind, pairs):
+    """A couple or uncouple command to formation pair ``e`` at step ``k``: arm or disarm it
+    (:mod:`tmem.coupling`); an uncouple command also starts the energy rule's fallback time.
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    e : int
+        The pair.
+    kind : int
+        ``COUPLE`` or ``UNCOUPLE`` (:data:`tmem.engine.records.COMMANDS`).
+    pairs : Pairs
+        The formation pairs, changed in place.
+    """
+    pairs.armed[e] = 1 if kind == COUPLE else 0
+    if kind == UNCOUPLE:
+        pairs.disarmed_at[e] = k  # the energy rule's fallback counts from here
+
+
 @numba.njit(cache=True)
 def apply_commands(k, commands, agents, pairs, events, counters, gas):
     """Carry out the commands due at step ``k``; return whether the neighbour lists must be rebuilt.
@@ -124,9 +145,7 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
             every = first == commands.ptr[c + 1]
             for t in range(pairs.armed.shape[0] if every else commands.ptr[c + 1] - first):
                 e = t if every else commands.target[first + t]
-                pairs.armed[e] = 1 if kind == COUPLE else 0
-                if kind == UNCOUPLE:
-                    pairs.disarmed_at[e] = k  # the energy rule's fallback counts from here
+                command_pair(k, e, kind, pairs)
             single = commands.ptr[c + 1] - first == 1
             i = pairs.i[commands.target[first]] if single else -1
             j = pairs.j[commands.target[first]] if single else -1
@@ -206,9 +225,7 @@ def _chunk_pushes(chunks, w, m, n_axes, function, params):
         for a in range(n_axes):
             r2 += chunks[w, a, t] * chunks[w, a, t]
         inside = (r2 < reach2) & (r2 > 0.0)
-        r = np.sqrt(r2)
-        push = pair_control(function, r, 0, params) / r
-        push = push if inside else 0.0
+        push = push_factor(function, r2, params)
         dist2 = 0.0
         for a in range(n_axes):
             dist2 += chunks[w, n_axes + a, t] * chunks[w, n_axes + a, t]

@@ -182,6 +182,30 @@ def _compile_dispatch():
 pair_control = _compile_dispatch()
 
 
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def push_factor(function, r2, p):
+    """``f(|d|) / |d|`` of a pair without a flag (``F_en = 0``) at ``|d|^2 = r2``: times ``d_a`` it is
+    the push on agent ``i`` along axis ``a``; 0 beyond reach and at ``|d| = 0``.
+
+    The step loop's neighbour stage and the per-agent controller (:mod:`tmem.agent`) push with it,
+    so both get the same bits.  Both branches are computed and one kept: a loop over pairs
+    that calls it still vectorises.
+
+    Parameters
+    ----------
+    function : int
+        The registry code (:func:`tmem.interaction.registry.code`).
+    r2 : float
+        ``|d|^2`` (m^2), ``d = P*_j - P*_i``.
+    p : FunctionParams
+        The functions' parameters.
+    """
+    inside = (r2 < p.reach * p.reach) & (r2 > 0.0)
+    r = np.sqrt(r2)
+    push = pair_control(function, r, 0, p) / r
+    return push if inside else 0.0
+
+
 @numba.njit(cache=True)
 def _evaluate(function, d, f_en, p, out):
     for t in range(d.size):
