@@ -97,6 +97,21 @@ def hex19():
     return with_commands("swarm/hex19.toml", 8.0, commands)
 
 
+def quadrotor_hex19():
+    """examples/vehicles/hex19.toml to 4 s: the nonlinear quadrotors' body states (attitude, rotor
+    speeds, height) are in flight at the checkpoint."""
+    return with_changes(tmem.load(ROOT / "examples/vehicles/hex19.toml"), {"simulation.duration": 4.0})
+
+
+def sensed_fig9():
+    """Fig. 9 to 12 s with noise, a random delay and lost messages: the ring of messages in flight
+    and the held ones are saved, the counter-based draws go on from the step."""
+    sensing = {"position_noise": 0.05, "velocity_noise": 0.02, "delay": [0.01, 0.05], "loss": 0.2, "seed": 3}
+    data = tmem.load(ROOT / "examples/fig9.toml").model_dump(mode="json", exclude_none=True)
+    data["simulation"]["duration"] = 12.0
+    return from_dict({**data, "sensing": sensing})
+
+
 # Each case: the scenario, the seconds between checkpoints, the checkpoint it stops after, and what
 # it has in flight there that a field left out of the checkpoint would change.
 CASES = {
@@ -104,6 +119,8 @@ CASES = {
     "neighbour lists": (neighbour_lists, 1.0, 2.0, lambda saved, run: 1 < saved.list_builds < run.list_builds),
     "gas box": (gas_box, 1.0, 3.0, lambda saved, run: saved.arrays["gas.target2"][0] == 9.0),  # the command's, not 4
     "hex19": (hex19, 2.0, 4.0, lambda saved, run: saved.arrays["agents.active"].sum() == 18),  # agent 3 lost
+    "quadrotor hex19": (quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.any(saved.arrays["agents.body"] != saved.arrays["agents.body_start"])),
+    "sensed fig9": (sensed_fig9, 2.0, 6.0, lambda saved, run: np.any(saved.arrays["sensing.history"] != 0.0)),
 }
 
 
