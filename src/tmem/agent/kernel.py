@@ -171,7 +171,8 @@ def control(k, own, gains, law_ints, law_floats, inbox, known, active, corrected
         Filled with ``U`` (rad), ``|U| <= c_max``.
     """
     law, params = law_from(gains, law_ints, law_floats)
-    agents = Agents(known, known, active, corrected, setpoint)
+    no_body = setpoint[:, :0]  # the pair rules read no body state: a view with no columns, nothing allocated
+    agents = Agents(known, known, active, corrected, setpoint, no_body, no_body)
     pairs = pairs_from(pair_ints, pair_floats, direction, d)
     events, counters = events_from(event_table, counts)
     n_axes = len(box)
