@@ -104,12 +104,12 @@ def quadrotor_hex19():
 
 
 def sensed_fig9():
-    """Fig. 9 to 12 s with noise, a random delay and lost messages: the ring of messages in flight
-    and the held ones are saved, the counter-based draws go on from the step."""
+    """Fig. 9 to 12 s (no command) with noise, a random delay and lost messages: the ring of
+    messages in flight and the held ones are saved, the counter-based draws go on from the step."""
     sensing = {"position_noise": 0.05, "velocity_noise": 0.02, "delay": [0.01, 0.05], "loss": 0.2, "seed": 3}
     data = tmem.load(ROOT / "examples/fig9.toml").model_dump(mode="json", exclude_none=True)
     data["simulation"]["duration"] = 12.0
-    return from_dict({**data, "sensing": sensing})
+    return from_dict({**data, "commands": [], "sensing": sensing})
 
 
 # Each case: the scenario, the seconds between checkpoints, the checkpoint it stops after, and what

@@ -51,10 +51,13 @@ class Topic:
 
 
 class SimulatedVehicle:
-    """One vehicle: its state (P, V, phi, omega per axis) and the model's step over dt."""
+    """One vehicle: its state (P, V, phi, omega per axis), its body state (what the model keeps beyond
+    the axes: the quadrotor's attitude, rotors and height; nothing for the linear model) and the
+    model's step over dt."""
 
     def __init__(self, model, start: np.ndarray, dt: float):
         self.state = start[np.newaxis].copy()  # the model's step works on an array of agents: here one
+        self.body = model.initial_body(self.state)
         self.setpoint = np.zeros((1, start.shape[0]))
         self._step, self._hold = type(model).step, model.step_params(dt)
 
@@ -66,7 +69,7 @@ class SimulatedVehicle:
 
     def advance(self) -> None:
         """Fly one period dt with the set-point held (already within c_max: scale 1)."""
-        self._step(self.state, self.setpoint, 0, 1.0, self._hold, self.state.shape[1])
+        self._step(self.state, self.body, self.setpoint, 0, 1.0, self._hold, self.state.shape[1])
 
 
 class AgentNode:
