@@ -2,7 +2,7 @@
 
 Two parts::
 
-    python docs/scripts/survive.py reruns          # the table of reruns, linear model beside quadrotor
+    python docs/scripts/survive.py reruns [NAME]   # the table of reruns, linear model beside quadrotor
     python docs/scripts/survive.py sweeps out      # tables and figures from the sweeps written under out/
 
 ``reruns`` flies the paper's Figs. 5, 7 and 9, the formation flights of docs/swarms.md and the gas
@@ -23,7 +23,7 @@ import numpy as np
 
 import tmem
 from tmem.metrics import summarize
-from tmem.scenario import Scenario, from_dict, load
+from tmem.scenario import Scenario, from_dict, load, with_changes
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 EXAMPLES = ROOT / "examples"
@@ -50,8 +50,9 @@ def _f(value, digits: int = 2, sign: bool = False) -> str:
     return f"{value:+.{digits}f}" if sign else f"{value:.{digits}f}"
 
 
-def pair_figures(summary: dict) -> dict:
+def pair_figures(trajectory) -> dict:
     """Figures of merit of a two-agent run: coupling, uncoupling, parting, RMS change, closest approach."""
+    summary = summarize(trajectory)
     pair = summary["pairs"][0]
     return {
         "couples at (s)": _f(pair["coupled_at"]) if summary["coupled"] else "never",
@@ -62,8 +63,9 @@ def pair_figures(summary: dict) -> dict:
     }
 
 
-def formation_figures(summary: dict) -> dict:
+def formation_figures(trajectory) -> dict:
     """Figures of merit of a formation flight: its edges' errors from ``d_t``, settling, RMS change."""
+    summary = summarize(trajectory)
     formation = summary["formation"]
     figures = {
         "largest edge error, 60 s (m)": _f(formation["distance_error"]["max"]),
@@ -80,9 +82,21 @@ def formation_figures(summary: dict) -> dict:
     return figures
 
 
-def gas_figures(summary: dict) -> dict:
-    """Figures of merit of the gas: whether it keeps its temperature, and how close agents come."""
-    return {"RMS change (%)": _f(summary["rms_change_percent"], 2, sign=True), "smallest distance (m)": _f(summary["min_distance"])}
+#: When the gas's random start has turned its overlaps into speed (s; docs/swarms.md, "A random start is not at rest").
+RELAXED = 10.0
+
+
+def gas_figures(trajectory) -> dict:
+    """Figures of merit of the gas: its RMS velocity once relaxed and at the end, and how close agents come."""
+    summary = summarize(trajectory)
+    velocity = trajectory.model.velocity(trajectory.state)
+    relaxed, end = (np.sqrt(np.mean(np.sum(velocity[k] ** 2, axis=-1))) for k in (np.searchsorted(trajectory.time, RELAXED), -1))
+    return {
+        "RMS change, 0-60 s (%)": _f(summary["rms_change_percent"], 2, sign=True),
+        f"RMS velocity at {RELAXED:g} s, at 60 s (m/s)": f"{relaxed:.3f}, {end:.3f}",
+        f"RMS change, {RELAXED:g}-60 s (%)": _f(100 * (end / relaxed - 1), 2, sign=True),
+        "smallest distance (m)": _f(summary["min_distance"]),
+    }
 
 
 def reruns() -> list[tuple[str, str, Scenario, Scenario, object]]:
@@ -95,11 +109,14 @@ def reruns() -> list[tuple[str, str, Scenario, Scenario, object]]:
     return runs + [("gas2d (400 agents)", "keeps its RMS velocity", gas, on_quadrotor(gas), gas_figures)]
 
 
-def print_reruns() -> None:
+def print_reruns(names: list[str]) -> None:
+    """The reruns' table; only the runs whose names start with one of ``names``, if any are given."""
     print("| run | paper | figure of merit | linear (2) | quadrotor |")
     print("| --- | --- | --- | --- | --- |")
     for name, paper, linear, quad, figures in reruns():
-        ours, theirs = figures(summarize(tmem.simulate(linear))), figures(summarize(tmem.simulate(quad)))
+        if names and not any(name.startswith(n) for n in names):
+            continue
+        ours, theirs = figures(tmem.simulate(linear)), figures(tmem.simulate(quad))
         for k, key in enumerate(ours):
             print(f"| {name if k == 0 else ''} | {paper if k == 0 else ''} | {key} | {ours[key]} | {theirs[key]} |", flush=True)
 
@@ -261,7 +278,7 @@ def grid_report(out: Path) -> None:
 
     rows = read(out, "hex19_grid")
     metric = "formation.distance_error_last_20s.max"
-    fig, panels = plt.subplots(1, 2, figsize=(10, 4))
+    fig, panels = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
     for ax, (synchronised, group) in zip(panels, rows.groupby("interaction.synchronise")):
         worst = group.groupby(["sensing.position_noise", "sensing.delay"])[metric].max().unstack()
         kept = worst.where(worst <= BAND)
@@ -281,13 +298,25 @@ def grid_report(out: Path) -> None:
         ax.set_xticks(range(len(worst.columns)), [f"{d:g}" for d in worst.columns])
         ax.set_yticks(range(len(worst.index)), [f"{n:g}" for n in worst.index])
         ax.set_xlabel("fixed delay (s)")
-        ax.set_ylabel("position noise (m); velocity = position / 3 s")
+        ax.set_ylabel("position noise (m); velocity = position / 3 s" if ax is panels[0] else "")
         ax.set_title(f"hex19 on the quadrotor, {title}", fontsize=9)
     fig.colorbar(image, ax=panels, label=f"largest edge error, last 20 s (m); bold: within {BAND} m")
     path = IMAGES / "vehicles-hex19-grid.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
     print(f"wrote {path.relative_to(ROOT)}", file=sys.stderr)
+
+
+def print_braking() -> None:
+    """The hex's mean velocity along its flight after 60 s, on both vehicles, exact and with stale data."""
+    print("\n### the hex's mean velocity at 60 s (m/s; 3 at the start)\n")
+    quad = load(EXAMPLES / "vehicles" / "hex19.toml")
+    for vehicle in ("quadrotor", "linear"):
+        base = quad if vehicle == "quadrotor" else with_changes(quad, {"model": {"kind": "linear"}})
+        for changes in ({}, {"sensing.period": 0.01}, {"sensing.period": 0.01, "sensing.delay": 0.05}):
+            trajectory = tmem.simulate(with_changes(base, changes))
+            mean = trajectory.model.velocity(trajectory.final_state).mean(axis=0)
+            print(f"- {vehicle}, {changes or 'exact'}: {mean[0]:.3f}")
 
 
 def print_references(refs: dict) -> None:
@@ -300,15 +329,16 @@ def print_references(refs: dict) -> None:
 def main(argv: list[str]) -> None:
     started = time.perf_counter()
     if argv[:1] == ["reruns"]:
-        print_reruns()
+        print_reruns(argv[1:])
     elif argv[:1] == ["sweeps"] and len(argv) == 2:
         refs = references()
         print_references(refs)
         fig9_report(Path(argv[1]), refs)
         hex_report(Path(argv[1]), refs)
         grid_report(Path(argv[1]))
+        print_braking()
     else:
-        sys.exit("usage: python docs/scripts/survive.py reruns | sweeps OUT")
+        sys.exit("usage: python docs/scripts/survive.py reruns [NAME ...] | sweeps OUT")
     print(f"{time.perf_counter() - started:.0f} s", file=sys.stderr)
 
 
