@@ -150,13 +150,20 @@ def _error_stats(error: np.ndarray) -> dict | None:
     return {"mean": float(error.mean()), "rms": float(np.sqrt(np.mean(error**2))), "max": float(error.max())}
 
 
+#: The last seconds of a run over which ``distance_error_last_20s`` is taken (s).
+LAST_WINDOW = 20.0
+
+
 def formation_summary(trajectory: Trajectory) -> dict | None:
     """Formation figures over all its pairs, or ``None`` without a formation.
 
     ``distance_error``: mean, RMS and largest ``|distance - d_t|`` over every
     pair and every recorded sample while coupled; ``direction_error_deg``: the
     largest angle between a pair's direction ``P_j - P_i`` and the direction it
-    must hold (pairs that hold one); ``formed_at``: when the last pair coupled,
+    must hold (pairs that hold one); ``distance_error_last_20s``: the same as
+    ``distance_error`` over the last :data:`LAST_WINDOW` s of the run (the whole
+    run if it is shorter), what a formation holds once its start's transient
+    has passed; ``formed_at``: when the last pair coupled,
     if all did (0 if they started coupled); ``coupled_at_end``: the share of
     pairs coupled at the end; ``settling_time``: the first recorded time from
     which every coupled pair stays within :data:`SETTLE_BAND` of its ``d_t`` to
@@ -172,7 +179,8 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
     if scenario.formation is None or not len(trajectory.pairs):
         return None
     flag = trajectory.flag == 1
-    error = np.abs(trajectory.pair_distance - trajectory.d_t)[flag]
+    error = np.abs(trajectory.pair_distance - trajectory.d_t)
+    last = (trajectory.time >= trajectory.time[-1] - LAST_WINDOW)[:, None] & flag
     couple_times = {}
     for e in trajectory.events:
         if e.kind == "couple":
@@ -181,7 +189,8 @@ def formation_summary(trajectory: Trajectory) -> dict | None:
     formed_at = 0.0 if start else (max(couple_times.values()) if len(couple_times) == len(trajectory.pairs) else None)
     result = {
         "pairs": len(trajectory.pairs),
-        "distance_error": _error_stats(error),
+        "distance_error": _error_stats(error[flag]),
+        "distance_error_last_20s": _error_stats(error[last]),
         "formed_at": formed_at,
         "coupled_at_end": float(coupling_states(trajectory)[2].mean()),
         "amplitude_max": None,

@@ -200,6 +200,8 @@ def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
 
     Example: ``with_changes(s, {"interaction.function": "repulsion", "agents[1].velocity": 2.0})``.
     A whole list can be replaced too: ``{"agents": [{"position": 0.0}, {"position": 50.0}]}``.
+    A key of an optional table the scenario leaves out (``sensing.delay`` without a ``[sensing]``
+    table) adds the table, with its defaults for the keys not given.
 
     Parameters
     ----------
@@ -209,13 +211,17 @@ def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
         New values by dotted path (``"table.key"``, ``"agents[i].key"``).
     """
     data = scenario.model_dump()
+    added = set()  # optional tables left out, added here: validation checks their keys
     for path, value in changes.items():
         parts = [int(p) if p.isdigit() else p for p in path.replace("[", ".").replace("]", "").split(".")]
         node = data
         try:
+            if len(parts) > 1 and data[parts[0]] is None:
+                data[parts[0]] = {}
+                added.add(parts[0])
             for part in parts[:-1]:
                 node = node[part]
-            if isinstance(node, dict) and parts[-1] not in node:
+            if isinstance(node, dict) and parts[-1] not in node and not (len(parts) == 2 and parts[0] in added):
                 raise KeyError(parts[-1])
             node[parts[-1]] = value
         except (KeyError, IndexError, TypeError):

@@ -84,7 +84,10 @@ _PAIR_KEYS = (
     "coupled_at|uncoupled_at|separated_at|min_distance|final_distance|mean_distance_coupled"
     "|oscillation_amplitude|distance_error\\.(mean|rms|max)"
 )
-_FORMATION_KEYS = "formed_at|coupled_at_end|amplitude_max|direction_error_deg|distance_error\\.(mean|rms|max)"
+_FORMATION_KEYS = (
+    "formed_at|coupled_at_end|amplitude_max|direction_error_deg|settling_time|residual_error"
+    "|distance_error(_last_20s)?\\.(mean|rms|max)"
+)
 _GAS_KEYS = (
     "rms_velocity|kinetic_energy_per_axis|density|pressure_virial|pressure_walls|pressure_wall_range"
     "|pressure_ideal|encounter_rate|mean_free_path|breaches"
