@@ -91,9 +91,10 @@ PER_COMPONENT = 10
 
 #: The wind's fields of the quadrotor's step record (:class:`tmem.model.quadrotor.QuadrotorStep`):
 #: the constant wind (m/s, world frame), the unit vector ``d`` along its horizontal part, whether
-#: there are gusts, their seed and the 30 numbers of (D6).
+#: there are gusts, their seed and the 30 numbers of (D6) (an array: a parallel loop takes no tuple
+#: in a record).
 WIND_FIELDS = [("wind_x", float), ("wind_y", float), ("wind_z", float), ("along_x", float), ("along_y", float),
-               ("turbulent", bool), ("seed", int), ("gust", tuple)]  # fmt: skip
+               ("turbulent", bool), ("seed", int), ("gust", np.ndarray)]  # fmt: skip
 
 
 def low_altitude_scales(height: float, w20: float) -> tuple[np.ndarray, np.ndarray]:
@@ -153,7 +154,7 @@ def _two_lags(sigma: float, steps: float) -> list[float]:
     return [*phi.ravel(), *(sigma * np.array([c[0, 0], c[1, 0], c[1, 1], s[0, 0], s[1, 0], s[1, 1]]))]
 
 
-def gust_coefficients(sigma: np.ndarray, length: np.ndarray, speed: float, dt: float) -> tuple[float, ...]:
+def gust_coefficients(sigma: np.ndarray, length: np.ndarray, speed: float, dt: float) -> np.ndarray:
     """The 30 numbers of (D6) for a step ``dt``: for ``u``, ``v``, ``w`` in turn, ``Phi`` by rows (4),
     the lower triangle of ``C`` (3) and of ``S`` (3).
 
@@ -172,7 +173,7 @@ def gust_coefficients(sigma: np.ndarray, length: np.ndarray, speed: float, dt: f
     steps_u = dt * speed / length[0]
     u = [math.exp(-steps_u), 0.0, 0.0, 0.0, sigma[0] * math.sqrt(-math.expm1(-2.0 * steps_u)), 0.0, 0.0, sigma[0], 0.0, 0.0]
     v, w = (_two_lags(sigma[c], dt * speed / length[c]) for c in (1, 2))
-    return tuple(float(n) for n in (*u, *v, *w))
+    return np.array([*u, *v, *w], dtype=float)
 
 
 def wind_fields(wind: Any, dt: float) -> tuple:
@@ -186,13 +187,13 @@ def wind_fields(wind: Any, dt: float) -> tuple:
         The step (s).
     """
     if wind is None:
-        return (0.0, 0.0, 0.0, 1.0, 0.0, False, 0, (0.0,) * (3 * PER_COMPONENT))
+        return (0.0, 0.0, 0.0, 1.0, 0.0, False, 0, np.zeros(3 * PER_COMPONENT))
     mean = wind.mean()
     horizontal = math.hypot(mean[0], mean[1])
     along = (mean[0] / horizontal, mean[1] / horizontal) if horizontal > 0.0 else (1.0, 0.0)
     gusts = wind.turbulence
     if gusts is None:
-        return (*mean, *along, False, 0, (0.0,) * (3 * PER_COMPONENT))
+        return (*mean, *along, False, 0, np.zeros(3 * PER_COMPONENT))
     sigma, length = scales(gusts)
     return (*mean, *along, True, gusts.seed, gust_coefficients(sigma, length, wind.passing_speed(), dt))
 
@@ -242,7 +243,7 @@ def _filter(g, lag, c, o, n1, n2):
             c[o + 2] * g + c[o + 3] * lag + c[o + 5] * n1 + c[o + 6] * n2)  # fmt: skip
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def next_gusts(z, c, seed, agent, step):
     """The gusts ``(u, v, w, v_lag, w_lag)`` of step ``step`` (>= 1) from those of the step before, (D6).
 
@@ -250,7 +251,7 @@ def next_gusts(z, c, seed, agent, step):
     ----------
     z : tuple of 5 float
         The gusts of step ``step - 1``.
-    c : tuple of 30 float
+    c : ndarray, shape (30,)
         :func:`gust_coefficients`.
     seed : int
         The turbulence's seed.
@@ -275,7 +276,7 @@ def first_gusts(c, seed, agent):
 
     Parameters
     ----------
-    c : tuple of 30 float
+    c : ndarray, shape (30,)
         :func:`gust_coefficients`.
     seed : int
         The turbulence's seed.
@@ -297,7 +298,7 @@ def gust_series(c, seed, agent, n_steps):
 
     Parameters
     ----------
-    c : tuple of 30 float
+    c : ndarray, shape (30,)
         :func:`gust_coefficients`.
     seed : int
         The turbulence's seed.
