@@ -22,7 +22,7 @@ import test_quadrotor as manoeuvres  # noqa: E402
 
 import tmem  # noqa: E402
 from tmem.metrics import formation_summary, summarize  # noqa: E402
-from tmem.model.quadrotor import BODY_NAMES, QuadrotorModel  # noqa: E402
+from tmem.model.quadrotor import BODY_NAMES, QuadrotorModel, step_quadrotor  # noqa: E402
 from tmem.model.wind import SEVERITY_W20  # noqa: E402
 from tmem.scenario import QuadrotorModelParams, WindParams, from_dict, load  # noqa: E402
 
@@ -48,6 +48,22 @@ def against_rotorpy() -> None:
         attitude = np.degrees(np.max(2.0 * np.arccos(np.minimum(dot, 1.0))))
         flown = np.sum(np.linalg.norm(np.diff(ours[:, :3], axis=0), axis=1))
         print(f"| {name} | {position:.1e} | {attitude:.1e} | {flown:.1f} |")
+
+
+def hover() -> None:
+    """One Crazyflie alone (``U = 0``) starting at rest and level in a constant wind along x, 60 s."""
+    print("| wind (m/s) | speed at 1 s (m/s) | at 60 s (m/s) | drift from 10 to 60 s (m/s²) | tilt (deg) |")
+    print("| --- | --- | --- | --- | --- |")
+    for w in (1.0, 3.0, 5.0):
+        model = QuadrotorModel(QuadrotorModelParams(kind="quadrotor"), WindParams(velocity=[w, 0.0]))
+        x = np.zeros((1, 2, 4))
+        body, params, u = model.initial_body(x), model.step_params(0.01), np.zeros((1, 2))
+        speeds = []
+        for _ in range(6000):
+            step_quadrotor(x, body, u, 0, 1.0, params, 2)
+            speeds.append(x[0, 0, 1])
+        drift = (speeds[-1] - speeds[999]) / 50.0
+        print(f"| {w:g} | {speeds[99]:.3f} | {speeds[-1]:.3f} | {drift:.1e} | {np.degrees(x[0, 0, 2]):.2f} |")
 
 
 def with_wind(scenario, wind: dict | None):
@@ -84,7 +100,7 @@ def fig9() -> None:
         trajectory = tmem.simulate(scenario)
         s = summarize(trajectory)
         pair = s["pairs"][0]
-        print(f"| {name} | {pair['coupled_at']} | {pair['uncoupled_at']} | {pair['separated_at']} | "
+        print(f"| {name} | {pair['coupled_at']} | {pair['uncoupled_at']} | {pair['separated_at'] and round(pair['separated_at'], 2)} | "
               f"{s['rms_change_percent']:+.3f} | {height(trajectory):.4f} |")  # fmt: skip
 
 
@@ -103,6 +119,6 @@ def hex19() -> None:
 
 
 if __name__ == "__main__":
-    for part in sys.argv[1:] and [globals()[p] for p in sys.argv[1:]] or (against_rotorpy, fig9, hex19):
+    for part in sys.argv[1:] and [globals()[p] for p in sys.argv[1:]] or (against_rotorpy, hover, fig9, hex19):
         print(f"\n## {part.__name__}\n", flush=True)
         part()
