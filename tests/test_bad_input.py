@@ -43,7 +43,7 @@ CASES = {
     "unknown function": (edit('function = "improved"', 'function = "magnet"'), "interaction.function", "'repulsion'"),
     "unknown action": (edit('action = "uncouple"', 'action = "explode"'), "commands[0].action", "'couple'"),
     "typo in key": (edit("c_max = 0.1", "cmax = 0.1"), "interaction.cmax", "unknown key"),
-    "unknown table": (GOOD + "\n[wind]\nspeed = 3.0\n", "wind", "unknown key"),
+    "unknown table": (GOOD + "\n[weather]\nspeed = 3.0\n", "weather", "unknown key"),
     "command before start": (edit("time = 29.0", "time = -1.0"), "commands[0].time", "must be greater than or equal to 0"),
     "command after end": (edit("time = 29.0", "time = 61.0"), "commands[0].time", "later than duration"),
     "command names missing agent": (edit("pair = [0, 1]", "pair = [0, 2]"), "commands[0].pair", "outside 0..1"),

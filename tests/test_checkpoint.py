@@ -103,6 +103,13 @@ def quadrotor_hex19():
     return with_changes(tmem.load(ROOT / "examples/vehicles/hex19.toml"), {"simulation.duration": 4.0})
 
 
+def turbulent_quadrotor_hex19():
+    """The quadrotor hex to 4 s in a wind with Dryden gusts: each agent's gust filters and the step of
+    its stream are in its body state at the checkpoint."""
+    wind = {"velocity": [2.0, 0.0], "turbulence": {"severity": "light", "seed": 1}}
+    return with_changes(quadrotor_hex19(), {"wind": wind})
+
+
 def sensed_fig9():
     """Fig. 9 to 12 s (no command) with noise, a random delay and lost messages: the ring of
     messages in flight and the held ones are saved, the counter-based draws go on from the step."""
@@ -120,6 +127,7 @@ CASES = {
     "gas box": (gas_box, 1.0, 3.0, lambda saved, run: saved.arrays["gas.target2"][0] == 9.0),  # the command's, not 4
     "hex19": (hex19, 2.0, 4.0, lambda saved, run: saved.arrays["agents.active"].sum() == 18),  # agent 3 lost
     "quadrotor hex19": (quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.any(saved.arrays["agents.body"] != saved.arrays["agents.body_start"])),
+    "turbulent quadrotor hex19": (turbulent_quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.all(saved.arrays["agents.body"][:, -1] > 0)),
     "sensed fig9": (sensed_fig9, 2.0, 6.0, lambda saved, run: np.any(saved.arrays["sensing.history"] != 0.0)),
 }
 

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from tmem.model.quadrotor import QuadrotorModel, axis_view, flight_commands, rate_loop, step_quadrotor
+from tmem.model.quadrotor import GUSTS, QuadrotorModel, axis_view, flight_commands, rate_loop, step_quadrotor
 from tmem.model.rigid_body import derivative, hover_speed
 from tmem.model.linear import state_matrices
 from tmem.scenario import QuadrotorModelParams
@@ -35,6 +35,8 @@ MANOEUVRES = {
     "step both": lambda t: (0.07 if t >= 1.0 else 0.0, 0.05 if t >= 2.0 else 0.0),
 }
 ALWAYS = ("sine x", "step both")
+#: No wind (m/s).
+CALM = (0.0, 0.0, 0.0)
 
 
 def quadrotor(**changes) -> QuadrotorModel:
@@ -44,7 +46,7 @@ def quadrotor(**changes) -> QuadrotorModel:
 def packed(x: np.ndarray, body: np.ndarray) -> tuple:
     """The 17-number body state of agent 0 of a 2-D run."""
     b = body[0]
-    return (x[0, 0, 0], x[0, 1, 0], b[0], x[0, 0, 1], x[0, 1, 1], b[1], *b[2:])
+    return (x[0, 0, 0], x[0, 1, 0], b[0], x[0, 0, 1], x[0, 1, 1], b[1], *b[2:GUSTS])
 
 
 def fly_tmem(model: QuadrotorModel, setpoint, start: np.ndarray) -> np.ndarray:
@@ -60,10 +62,14 @@ def fly_tmem(model: QuadrotorModel, setpoint, start: np.ndarray) -> np.ndarray:
     return np.array(states)
 
 
-def fly_rotorpy(model: QuadrotorModel, setpoint, first: np.ndarray) -> np.ndarray:
-    """The same with RotorPy's ``Multirotor`` and its own integration, from the same state."""
+def fly_rotorpy(model: QuadrotorModel, setpoint, first: np.ndarray, wind=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """The same with RotorPy's ``Multirotor`` and its own integration, from the same state, in
+    RotorPy's ``ConstantWind`` ``wind`` (m/s, world frame)."""
     multirotor = pytest.importorskip("rotorpy.vehicles.multirotor")
     from rotorpy.vehicles.crazyflie_params import quad_params
+    from rotorpy.wind.default_winds import ConstantWind
+
+    air = ConstantWind(*wind)
 
     p = model.params
     assert (p.mass, p.ixx, p.izz, p.k_eta, p.k_m, p.tau_m) == tuple(quad_params[k] for k in ("mass", "Ixx", "Izz", "k_eta", "k_m", "tau_m"))
@@ -74,7 +80,8 @@ def fly_rotorpy(model: QuadrotorModel, setpoint, first: np.ndarray) -> np.ndarra
     states = [first]
     for k in range(round(DURATION / PERIOD)):
         s = tuple(np.concatenate([state["x"], state["v"], state["q"], state["w"], state["rotor_speeds"]]))
-        thrust, *rates = flight_commands(s, *setpoint(k * PERIOD), params)
+        state["wind"] = air.update(k * PERIOD, state["x"])  # as RotorPy's Environment sets it
+        thrust, *rates = flight_commands(s, *setpoint(k * PERIOD), params, tuple(state["wind"]))
         state = vehicle.step(state, {"cmd_thrust": thrust, "cmd_w": np.array(rates)}, PERIOD)
         states.append(np.concatenate([state["x"], state["v"], state["q"], state["w"], state["rotor_speeds"]]))
     return np.array(states)
@@ -102,9 +109,9 @@ def axis_derivative(model: QuadrotorModel, axis: int, x: np.ndarray, u: float) -
     s = packed(state, model.initial_body(state))
     params = model.step_params(model.params.inner_period)
     for _ in range(20):  # the rotors at their command: a fixed point (the feed-forward reads their drag)
-        command = rate_loop(s, *flight_commands(s, *((u, 0.0) if axis == 0 else (0.0, u)), params), params)
+        command = rate_loop(s, *flight_commands(s, *((u, 0.0) if axis == 0 else (0.0, u)), params, CALM), params)
         s = s[:13] + command
-    slope = np.array(derivative(s, command, params))
+    slope = np.array(derivative(s, command, params, CALM))
     eps = 1e-6
 
     def view(t):  # (P, V, phi, omega) on the axis
@@ -147,7 +154,7 @@ def test_at_hover_the_rotors_turn_at_the_speed_that_carries_the_weight_and_nothi
     model = quadrotor()
     start = np.zeros((1, 2, 4))
     body = model.initial_body(start)
-    np.testing.assert_allclose(body[0, 9:], math.sqrt(0.03 * 9.81 / (4 * 2.3e-8)))
+    np.testing.assert_allclose(body[0, 9:GUSTS], math.sqrt(0.03 * 9.81 / (4 * 2.3e-8)))
     assert hover_speed(model.airframe()) == pytest.approx(1788.53, abs=0.05)  # RotorPy's hover speed, rounded
     x, params = start.copy(), model.step_params(0.01)
     for _ in range(100):

@@ -203,7 +203,7 @@ def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None
         for controller in controllers:
             controller.reset()
     sim = scenario.simulation
-    model = vehicle_model(scenario.model)
+    model = vehicle_model(scenario.model, scenario.wind)
     vehicle_step, hold = type(model).step, model.step_params(sim.dt)  # the class's kernel, not a bound method
     x = build(scenario).state.copy()
     body = model.initial_body(x)

@@ -351,7 +351,7 @@ def simulate(
     """
     resume = checkpoints.start(scenario, record, sensing) if checkpoints is not None else None
     sim, c = scenario.simulation, scenario.controller
-    model = vehicle_model(scenario.model)
+    model = vehicle_model(scenario.model, scenario.wind)
     gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
     initial = build(scenario)
     run = _run_of(scenario, initial, record)

@@ -19,13 +19,17 @@ MODELS: dict[str, str] = {
 }
 
 
-def vehicle_model(params: Any):
+def vehicle_model(params: Any, wind: Any = None):
     """The :class:`~tmem.model.base.VehicleModel` for a scenario's ``[model]`` table (by its ``kind``).
 
     Parameters
     ----------
     params
         The validated ``[model]`` table, e.g. :class:`~tmem.scenario.tables.LinearModelParams`.
+    wind
+        The scenario's ``[wind]`` table, for a model that feels it (the quadrotor's: the schema
+        refuses it with another); default: none.
     """
     module, name = MODELS[params.kind].split(":")
-    return getattr(import_module(module), name)(params)
+    model_class = getattr(import_module(module), name)
+    return model_class(params) if wind is None else model_class(params, wind)

@@ -55,7 +55,7 @@ altitude hold's.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
@@ -64,27 +64,33 @@ from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any
 from .base import VehicleModel
 from .linear import STATE_NAMES
 from .rigid_body import Airframe, derivative, hover_speed, rotation, rotor_commands, wrench
+from .wind import GUST_LONG_NAMES, GUST_NAMES, GUST_UNITS, WIND_FIELDS, advance_gusts, initial_gusts, wind_fields, wind_now
 
-#: The per-agent body state, after the per-axis ``(P, V, phi, omega)``.
-BODY_NAMES = ("height", "v_z", "q_x", "q_y", "q_z", "q_w", "w_x", "w_y", "w_z", "rotor_1", "rotor_2", "rotor_3", "rotor_4")
-BODY_UNITS = ("m", "m s-1", "1", "1", "1", "1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1")
+#: The per-agent body state, after the per-axis ``(P, V, phi, omega)``: the rigid body's, then the
+#: gusts of :mod:`tmem.model.wind` from column :data:`GUSTS` (zeros without turbulence).
+RIGID_BODY_NAMES = ("height", "v_z", "q_x", "q_y", "q_z", "q_w", "w_x", "w_y", "w_z", "rotor_1", "rotor_2", "rotor_3", "rotor_4")
+GUSTS = len(RIGID_BODY_NAMES)
+BODY_NAMES = RIGID_BODY_NAMES + GUST_NAMES
+BODY_UNITS = ("m", "m s-1", "1", "1", "1", "1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1", "rad s-1",
+              *GUST_UNITS)  # fmt: skip
 BODY_LONG_NAMES = (
     "height above the start", "vertical velocity",
     "attitude quaternion x", "attitude quaternion y", "attitude quaternion z", "attitude quaternion w",
     "body rate about x", "body rate about y", "body rate about z",
-    "speed of rotor 1", "speed of rotor 2", "speed of rotor 3", "speed of rotor 4",
+    "speed of rotor 1", "speed of rotor 2", "speed of rotor 3", "speed of rotor 4", *GUST_LONG_NAMES,
 )  # fmt: skip
 
 
 #: What one step of ``dt`` needs: the airframe's numbers (:class:`~tmem.model.rigid_body.Airframe`'s
 #: fields, so that the record serves as the airframe), then the inner loop's gains ``kp``, ``kd``
 #: (Q5)-(Q6) (1/s) and ``altitude_kp``, ``altitude_kd`` (Q7) (1/s^2, 1/s), whether the drag
-#: feed-forward (Q8) is on, the number of sub-steps in ``dt`` and the sub-step ``h`` (s).  One flat
-#: record: a parallel loop takes no record nested in another.
+#: feed-forward (Q8) is on, the number of sub-steps in ``dt`` and the sub-step ``h`` (s), and the
+#: wind (:data:`tmem.model.wind.WIND_FIELDS`).  One flat record: a parallel loop takes no record
+#: nested in another.
 QuadrotorStep = NamedTuple(
     "QuadrotorStep",
     [*Airframe.__annotations__.items(), ("kp", float), ("kd", float), ("altitude_kp", float), ("altitude_kd", float),
-     ("feedforward", bool), ("substeps", int), ("h", float)],
+     ("feedforward", bool), ("substeps", int), ("h", float), *WIND_FIELDS],
 )  # fmt: skip
 
 
@@ -111,8 +117,12 @@ def axis_view(s):
 
 
 @numba.njit(cache=True, inline="always")
-def flight_commands(s, ux, uy, params):
+def flight_commands(s, ux, uy, params, wind):
     """Collective thrust and body-rate set-points ``(T, w_x,d, w_y,d, w_z,d)``, (Q5), (Q7) and (Q8).
+
+    The feed-forward (Q8) balances the aerodynamic force the vehicle feels, the drag of its
+    airspeed: an accelerometer measures it (the specific force less the rotors' thrust), with no
+    knowledge of the wind.
 
     Parameters
     ----------
@@ -121,11 +131,13 @@ def flight_commands(s, ux, uy, params):
     ux, uy : float
         Tilt set-points ``U`` on x and y (rad).
     params : QuadrotorStep
+    wind : tuple of 3 float
+        The wind (m/s, world frame), (D1) of :mod:`tmem.model.wind`.
     """
     frame = params
     r = rotation(s[6], s[7], s[8], s[9])
     if params.feedforward:
-        _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame)
+        _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, wind)
         weight = frame.mass * frame.g
         ux += math.atan(-(r[0] * ax + r[1] * ay + r[2] * az) / weight)
         uy += math.atan(-(r[3] * ax + r[4] * ay + r[5] * az) / weight)
@@ -186,7 +198,7 @@ def _mean_slope(k1, k2, k3, k4):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def substep(s, ux, uy, params):
+def substep(s, ux, uy, params, wind):
     """One sub-step ``h``: the flight controller's commands, held, and one RK4 step of (Q1)-(Q4).
 
     Returns the body's state after it, its quaternion normalised.  It is called, not inlined: the
@@ -200,14 +212,16 @@ def substep(s, ux, uy, params):
     ux, uy : float
         Tilt set-points ``U`` on x and y (rad).
     params : QuadrotorStep
+    wind : tuple of 3 float
+        The wind, held over the sub-step (m/s, world frame).
     """
     frame, h = params, params.h
-    thrust, rate_x, rate_y, rate_z = flight_commands(s, ux, uy, params)
+    thrust, rate_x, rate_y, rate_z = flight_commands(s, ux, uy, params, wind)
     command = rate_loop(s, thrust, rate_x, rate_y, rate_z, params)
-    k1 = derivative(s, command, frame)
-    k2 = derivative(_plus(s, k1, 0.5 * h), command, frame)
-    k3 = derivative(_plus(s, k2, 0.5 * h), command, frame)
-    k4 = derivative(_plus(s, k3, h), command, frame)
+    k1 = derivative(s, command, frame, wind)
+    k2 = derivative(_plus(s, k1, 0.5 * h), command, frame, wind)
+    k3 = derivative(_plus(s, k2, 0.5 * h), command, frame, wind)
+    k4 = derivative(_plus(s, k3, h), command, frame, wind)
     s = _plus(s, _mean_slope(k1, k2, k3, k4), h)
     n = 1.0 / math.sqrt(s[6] * s[6] + s[7] * s[7] + s[8] * s[8] + s[9] * s[9])
     return (s[0], s[1], s[2], s[3], s[4], s[5], s[6] * n, s[7] * n, s[8] * n, s[9] * n,
@@ -216,13 +230,14 @@ def substep(s, ux, uy, params):
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def step_quadrotor(x, body, u, i, scale, params, n_axes):
-    """Advance agent ``i`` over one step with the tilt set-points ``U = u[i] * scale`` held.
+    """Advance agent ``i`` over one step with the tilt set-points ``U = u[i] * scale`` and the wind held,
+    then draw its gusts of the next step (:mod:`tmem.model.wind`).
 
     Parameters
     ----------
     x : ndarray, shape (agents, axes, 4)
         Per-axis states ``(P, V, phi, omega)``, changed in place.
-    body : ndarray, shape (agents, 13)
+    body : ndarray, shape (agents, 20)
         Body states (:data:`BODY_NAMES`), changed in place.
     u : ndarray, shape (agents, axes)
         Summed tilt set-points (rad).
@@ -240,8 +255,9 @@ def step_quadrotor(x, body, u, i, scale, params, n_axes):
     b = body
     s = (x[i, 0, 0], x[i, 1, 0] if two else 0.0, b[i, 0], x[i, 0, 1], x[i, 1, 1] if two else 0.0, b[i, 1],
          b[i, 2], b[i, 3], b[i, 4], b[i, 5], b[i, 6], b[i, 7], b[i, 8], b[i, 9], b[i, 10], b[i, 11], b[i, 12])  # fmt: skip
+    wind = wind_now(b, i, GUSTS, params, two)
     for _ in range(params.substeps):
-        s = substep(s, ux, uy, params)
+        s = substep(s, ux, uy, params, wind)
     x[i, 0, 0], x[i, 0, 1] = s[0], s[3]
     tilt_x, rate_x, tilt_y, rate_y = axis_view(s)
     x[i, 0, 2], x[i, 0, 3] = tilt_x, rate_x
@@ -250,6 +266,8 @@ def step_quadrotor(x, body, u, i, scale, params, n_axes):
     b[i, 0], b[i, 1] = s[2], s[5]
     for m in range(11):
         b[i, 2 + m] = s[6 + m]
+    if params.turbulent:
+        advance_gusts(b, i, GUSTS, params)
 
 
 def attitude_of_tilts(tilt_x: float, tilt_y: float) -> tuple[float, float, float, float]:
@@ -277,6 +295,8 @@ class QuadrotorModel(VehicleModel):
     ----------
     params
         The scenario's ``[model]`` table, :class:`~tmem.scenario.tables.QuadrotorModelParams`.
+    wind
+        The scenario's ``[wind]`` table, :class:`~tmem.scenario.wind_table.WindParams` (default: none).
     """
 
     kind = "quadrotor"
@@ -287,6 +307,10 @@ class QuadrotorModel(VehicleModel):
     body_units = BODY_UNITS
     body_long_names = BODY_LONG_NAMES
     step = step_quadrotor
+
+    def __init__(self, params: Any, wind: Any = None):
+        super().__init__(params)
+        self.wind = wind
 
     def airframe(self) -> Airframe:
         """The rigid body's numbers, from the ``[model]`` table."""
@@ -337,13 +361,14 @@ class QuadrotorModel(VehicleModel):
         p = self.params
         substeps = max(1, math.ceil(dt / p.inner_period - 1e-9))
         return QuadrotorStep(*self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward,
-                             substeps, dt / substeps)  # fmt: skip
+                             substeps, dt / substeps, *wind_fields(self.wind, dt))  # fmt: skip
 
     def initial_body(self, state: np.ndarray) -> np.ndarray:
         """Body states for per-axis states: at height 0, not climbing, yaw 0, rotors carrying the weight.
 
         The attitude has each axis's tilt (:func:`attitude_of_tilts`), the body rates give each
-        axis's tilt rate (:func:`axis_view` inverted) with no yaw rate.
+        axis's tilt rate (:func:`axis_view` inverted) with no yaw rate; the gusts are each agent's
+        first (:func:`tmem.model.wind.initial_gusts`: ``state`` in the scenario's order of agents).
 
         Parameters
         ----------
@@ -361,5 +386,6 @@ class QuadrotorModel(VehicleModel):
             b3z = rotation(*q)[8]
             body[i, 2:6] = q
             body[i, 6:8] = w
-            body[i, 9:] = math.sqrt(frame.mass * frame.g / (4.0 * frame.k_eta * b3z))
+            body[i, 9:GUSTS] = math.sqrt(frame.mass * frame.g / (4.0 * frame.k_eta * b3z))
+        body[:, GUSTS:] = initial_gusts(self.wind, len(state))
         return body

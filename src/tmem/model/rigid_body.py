@@ -1,14 +1,14 @@
 """A quadrotor as a rigid body with four rotors: the equations of RotorPy's ``Multirotor``, compiled.
 
 The body's state, one flat tuple of 17 numbers in RotorPy's order (its wind
-left out)::
+kept apart, a tuple ``(w_x, w_y, w_z)`` handed to each function)::
 
     (x, y, z, v_x, v_y, v_z, q_x, q_y, q_z, q_w, w_x, w_y, w_z, o_1, o_2, o_3, o_4)
 
 position and velocity in the world frame (m, m/s; ``z`` up), the attitude as a
 quaternion, scalar last, rotating body to world, the body rates (rad/s) and the
-rotor speeds (rad/s).  With ``R`` the attitude's rotation, ``v_b = R^T v`` the
-airspeed in the body frame and ``r_k`` the hub of rotor ``k`` (Folk et al.,
+rotor speeds (rad/s).  With ``R`` the attitude's rotation, ``v_b = R^T (v - w)`` the
+airspeed in the body frame (``w`` the wind, :mod:`tmem.model.wind`) and ``r_k`` the hub of rotor ``k`` (Folk et al.,
 RotorPy, ``rotorpy/vehicles/multirotor.py``)::
 
     x'   = v
@@ -26,8 +26,8 @@ RotorPy, ``rotorpy/vehicles/multirotor.py``)::
 rotors sit at ``(+a, +a)``, ``(+a, -a)``, ``(-a, -a)``, ``(-a, +a)`` (``a`` is the
 arm length over sqrt 2: RotorPy's Crazyflie in its X configuration) and turn
 ``+1, -1, +1, -1``.  RotorPy's translational lift ``k_h`` and flapping moment
-``k_flap`` are zero for the Crazyflie and left out; so are its wind, its ground
-and its motor noise.  Like RotorPy, ``R`` is the rotation of the normalised
+``k_flap`` are zero for the Crazyflie and left out; so are its ground and its
+motor noise.  Like RotorPy, ``R`` is the rotation of the normalised
 quaternion, and (Q2) does not renormalise: a step does, after it.
 """
 
@@ -118,7 +118,7 @@ def rotation(qx, qy, qz, qw):
 
 
 @numba.njit(cache=True, inline="always")
-def wrench(s, r, frame):
+def wrench(s, r, frame, wind):
     """Force and moment on the body, in the body frame, and the aerodynamic part of the force.
 
     Returns ``(f_x, f_y, f_z, m_x, m_y, m_z, a_x, a_y, a_z)``: ``F_b``, ``M_b`` and ``sum_k H_k + D``
@@ -131,10 +131,13 @@ def wrench(s, r, frame):
     r : tuple of 9 float
         Its attitude's :func:`rotation`.
     frame : Airframe
+    wind : tuple of 3 float
+        The wind ``w`` (m/s, world frame).
     """
-    ub = r[0] * s[3] + r[3] * s[4] + r[6] * s[5]  # v_b = R^T v
-    vb = r[1] * s[3] + r[4] * s[4] + r[7] * s[5]
-    wb = r[2] * s[3] + r[5] * s[4] + r[8] * s[5]
+    air_x, air_y, air_z = s[3] - wind[0], s[4] - wind[1], s[5] - wind[2]  # the airspeed, world frame
+    ub = r[0] * air_x + r[3] * air_y + r[6] * air_z  # v_b = R^T (v - w)
+    vb = r[1] * air_x + r[4] * air_y + r[7] * air_z
+    wb = r[2] * air_x + r[5] * air_y + r[8] * air_z
     wx, wy, wz = s[10], s[11], s[12]
     norm = math.sqrt(ub * ub + vb * vb + wb * wb)
     ax, ay, az = -norm * frame.c_dx * ub, -norm * frame.c_dy * vb, -norm * frame.c_dz * wb
@@ -158,7 +161,7 @@ def wrench(s, r, frame):
 
 
 @numba.njit(cache=True, inline="always")
-def derivative(s, command, frame):
+def derivative(s, command, frame, wind):
     """``s'`` of (Q1)-(Q4): the body's state changing under the rotor speeds ``command``.
 
     Parameters
@@ -168,9 +171,11 @@ def derivative(s, command, frame):
     command : tuple of 4 float
         The rotors' commanded speeds ``c_k`` (rad/s).
     frame : Airframe
+    wind : tuple of 3 float
+        The wind (m/s, world frame).
     """
     r = rotation(s[6], s[7], s[8], s[9])
-    fx, fy, fz, mx, my, mz, _, _, _ = wrench(s, r, frame)
+    fx, fy, fz, mx, my, mz, _, _, _ = wrench(s, r, frame, wind)
     qx, qy, qz, qw = s[6], s[7], s[8], s[9]
     wx, wy, wz = s[10], s[11], s[12]
     inverse_tau, inverse_mass = 1.0 / frame.tau_m, 1.0 / frame.mass

@@ -10,12 +10,14 @@ message naming the field and the reason.  Defaults are documented in
 * :mod:`~tmem.scenario.tables` — one pydantic model per table, and the number types;
 * :mod:`~tmem.scenario.schema` — :class:`Scenario`, the tables checked against each other;
 * :mod:`~tmem.scenario.sensing_table` — the ``[sensing]`` table and its checks against the scenario;
+* :mod:`~tmem.scenario.wind_table` — the ``[wind]`` table (the quadrotor's wind) and its checks;
 * :mod:`~tmem.scenario.files` — reading, writing and editing files; the presets.
 """
 
 from .files import PRESETS, describe, from_dict, load, loads, preset, read_text, with_changes
 from .schema import MAX_AGENTS_ALL_PAIRS, MAX_RECORD_BYTES, TRACK_ALL_PAIRS, Scenario
 from .sensing_table import SensingParams
+from .wind_table import TurbulenceParams, WindParams
 from .tables import (
     LIMIT,
     MODEL_KINDS,
@@ -75,7 +77,9 @@ __all__ = [
     "StrictModel",
     "SwarmParams",
     "ThermostatParams",
+    "TurbulenceParams",
     "Vector",
+    "WindParams",
     "describe",
     "from_dict",
     "load",

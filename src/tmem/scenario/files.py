@@ -267,4 +267,6 @@ def _toml_value(v) -> str:
         return repr(v) if math.isfinite(v) else str(v)
     if isinstance(v, list | tuple):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):  # a table inside a table ([wind.turbulence]), written inline
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     return str(v)

@@ -3,8 +3,8 @@
 A scenario is a TOML file with the tables ``[model]`` (Table 1),
 ``[controller]`` (roots (5)), ``[interaction]``, ``[simulation]``,
 ``[[agents]]`` (Table 2) and ``[[commands]]``, and optionally ``[space]``,
-``[neighbors]``, ``[formation]``, ``[swarm]`` and ``[sensing]`` (:mod:`tmem.scenario.tables`,
-:mod:`tmem.scenario.sensing_table`).
+``[neighbors]``, ``[formation]``, ``[swarm]``, ``[sensing]`` and ``[wind]`` (:mod:`tmem.scenario.tables`,
+:mod:`tmem.scenario.sensing_table`, :mod:`tmem.scenario.wind_table`).
 Every key is checked: unknown keys, non-finite numbers and values out of range
 are refused; :func:`tmem.scenario.files.describe` turns the errors into the one
 line of a :class:`ScenarioError`.  Defaults are documented in
@@ -43,6 +43,7 @@ from .tables import (
     per_axis,
 )
 from .sensing_table import SensingParams, check_sensing
+from .wind_table import WindParams, check_wind
 
 #: Most bytes a run may set aside for its records.
 MAX_RECORD_BYTES = 8 * 2**30
@@ -106,6 +107,7 @@ class Scenario(StrictModel):
     thermostat: ThermostatParams | None = None
     coverage: CoverageParams | None = None
     sensing: SensingParams | None = None
+    wind: WindParams | None = None
     obstacles: list[Obstacle] = []
     agents: list[Agent] = []
     commands: list[Command] = []
@@ -210,6 +212,7 @@ class Scenario(StrictModel):
                     raise FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
         self._check_memory(n)  # before generating anything
         check_sensing(self, n, self.neighbors.uses_lists(n), memory_limit())
+        check_wind(self)
         pairs = self.pairs()  # generating a large formation is not free: once per validation
         if self.simulation.record_agents == [] and not len(pairs):
             raise FieldError(
