@@ -23,17 +23,12 @@ over it, so a 400-frame GIF of 20 agents takes a few seconds.
 
 from __future__ import annotations
 
-import gc
-import sys
 import tomllib
 import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 from matplotlib import animation
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection, LineCollection
@@ -45,6 +40,7 @@ from PIL import Image
 from . import __version__
 from .outputs import ANIMATE_MARK, check_file, replace_file
 from .plot import draw_region
+from .trajectory_file import Refused, open_trajectory, positions, read_run, run_axes
 
 #: Most agents drawn; larger runs are thinned evenly to this many.
 MAX_AGENTS_DRAWN = 3000
@@ -87,80 +83,28 @@ def _columns(ids: np.ndarray, wanted: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return k, ids[k] == wanted
 
 
-class _Refused(ValueError):
-    """A readable trajectory that cannot be animated; its message is final."""
-
-
-def _trajectory_path(run_dir: Path) -> Path:
-    """``run_dir``'s ``trajectory.nc`` (or ``run_dir`` itself, an ``.nc`` file); refuse one that is not there."""
-    if run_dir.suffix == ".nc":
-        if not run_dir.is_file():
-            raise ValueError(f"animate: {run_dir}: {'is not a file' if run_dir.exists() else 'no such file'}")
-        return run_dir
-    if not run_dir.exists():
-        raise ValueError(f"animate: {run_dir}: no such folder")
-    if not run_dir.is_dir():
-        raise ValueError(f"animate: {run_dir}: is a file, not a run folder; give the folder tmem run wrote")
-    if not (run_dir / "trajectory.nc").is_file():
-        raise ValueError(f"animate: no trajectory.nc in {run_dir}; give a folder written by tmem run")
-    return run_dir / "trajectory.nc"
-
-
-@contextmanager
-def _quiet_unraisable() -> Iterator[None]:
-    """Silence errors raised while objects are freed (h5netcdf's half-opened file on a damaged one)."""
-    hook = sys.unraisablehook
-    sys.unraisablehook = lambda unraisable: None
-    try:
-        yield
-    finally:
-        gc.collect()
-        sys.unraisablehook = hook
-
-
-def _reason(exc: Exception) -> str:
-    """An exception as a short phrase of one line: its message, or its class when it has none."""
-    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
-    text = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
-    return text if len(text) <= 200 else text[:197] + "..."
-
-
 def _load(run_dir: Path, max_frames: int) -> _Run:
-    """Read the frames and agents to draw; a damaged or truncated ``trajectory.nc`` is refused in one line.
-
-    A damaged file fails in h5py, h5netcdf, xarray or NumPy, each in its own way (``OSError``,
-    ``KeyError``, ``RuntimeError``, ``MemoryError``...): any such failure while reading names the
-    file and the reason.
-    """
-    path = _trajectory_path(run_dir)
-    message = None
-    with _quiet_unraisable():
-        try:
-            return _read(path, max_frames)
-        except _Refused:
-            raise
-        except Exception as exc:  # noqa: BLE001 - see the docstring
-            message = f"animate: {path}: cannot be read as a run's trajectory ({_reason(exc)})"
-    raise ValueError(message)  # outside the handler: the failed file is freed, quietly, before this
+    """Read the frames and agents to draw; a missing, damaged or truncated ``trajectory.nc`` is refused in one line."""
+    return read_run(run_dir, "animate", lambda path: _read(path, max_frames))
 
 
 def _read(path: Path, max_frames: int) -> _Run:
     """Read the frames and agents to draw from ``path``; refuse runs that are not 2-D."""
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        n_axes = ds.sizes.get("axis", 0)
+    with open_trajectory(path) as ds:
+        n_axes = len(run_axes(ds))
         if n_axes != 2:
             noun = "axis" if n_axes == 1 else "axes"
-            raise _Refused(f"animate: the run has {n_axes} {noun}; only 2-D runs can be animated")
+            raise Refused(f"animate: the run has {n_axes} {noun}; only 2-D runs can be animated")
         if ds.sizes["time"] == 0 or ds.sizes["agent"] == 0:
-            raise _Refused("animate: the run has no recorded times or agents")
+            raise Refused("animate: the run has no recorded times or agents")
         try:
             scenario = tomllib.loads(ds.attrs["scenario"])
             radius = float(scenario["interaction"]["radius"])
         except (KeyError, TypeError, ValueError) as error:
-            raise _Refused(f"animate: {path}: the run's scenario attribute gives no interaction.radius") from error
+            raise Refused(f"animate: {path}: the run's scenario attribute gives no interaction.radius") from error
         sub = ds.isel(time=_evenly(ds.sizes["time"], max_frames), agent=_evenly(ds.sizes["agent"], MAX_AGENTS_DRAWN))
-        pos = sub["P"].values.astype(float)
-        active = sub["active"].values.astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
+        pos = positions(sub)
+        active = sub["active"].transpose("time", "agent").values.astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
         # Edges whose two agents are both drawn (``pair_i``/``pair_j`` hold agent indices).
         col_i, ok_i = _columns(sub["agent"].values, ds["pair_i"].values)
         col_j, ok_j = _columns(sub["agent"].values, ds["pair_j"].values)
@@ -175,7 +119,7 @@ def _read(path: Path, max_frames: int) -> _Run:
             active=active,
             col_i=col_i[kept],
             col_j=col_j[kept],
-            flag=sub["F_en"].isel(pair=kept).values if kept.size else np.zeros((sub.sizes["time"], 0), np.int8),
+            flag=sub["F_en"].isel(pair=kept).transpose("time", "pair").values if kept.size else np.zeros((sub.sizes["time"], 0), np.int8),
             d_t=d_t,
             radius=radius,
             name=str(scenario.get("name", "")),
