@@ -204,7 +204,7 @@ def _check_file(out: Path, mark: str, where: str) -> Path:
         if parent.exists() and not parent.is_dir():
             raise OutputError(f"{where}: {parent} is a file, not a directory")
     if out.exists() and not _has_mark(out, mark.encode()):
-        raise OutputError(f"{where}: exists and was not written by tmem animate; choose another --out or remove it")
+        raise OutputError(f"{where}: exists and was not {mark}; choose another --out or remove it")
     return out
 
 
