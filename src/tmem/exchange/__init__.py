@@ -28,7 +28,7 @@ def export(run_dir: str | Path, to: str, out: str | Path | None = None) -> Path:
     Parameters
     ----------
     run_dir : str or Path
-        A directory written by ``tmem run``.
+        A directory written by ``tmem run`` (or its ``trajectory.nc``).
     to : str
         One of :data:`FORMATS`.
     out : str or Path, optional
@@ -49,7 +49,8 @@ def export(run_dir: str | Path, to: str, out: str | Path | None = None) -> Path:
         raise ValueError(f"--to: must be one of {', '.join(FORMATS)}, got {to!r}")
     run_dir = Path(run_dir)
     label = "--out " if out is not None else ""
-    target = Path(out) if out is not None else run_dir / DEFAULT_OUT[to]
+    folder = run_dir.parent if run_dir.suffix == ".nc" else run_dir  # a trajectory.nc given for its folder
+    target = Path(out) if out is not None else folder / DEFAULT_OUT[to]
     if to == "mcap":
         from .foxglove import EXPORT_MARK, export_mcap
 

@@ -48,7 +48,7 @@ def write_csv_files(recording: Recording, directory: Path) -> list[Path]:
     quaternions = attitude_quaternion(recording.tilts[..., 0], recording.tilts[..., 1])
     written = []
     for k in range(len(recording.agents)):
-        rows = np.column_stack([recording.time, recording.positions[:, k], quaternions[:, k]])
+        rows = np.column_stack([recording.time, recording.positions[:, k], quaternions[:, k]]) + 0.0  # no -0.0
         path = directory / csv_name(recording.number(k))
         with path.open("w", newline="", encoding="ascii") as f:
             writer = csv.writer(f, lineterminator="\n")

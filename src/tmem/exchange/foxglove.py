@@ -59,36 +59,32 @@ def pair_topic(name_i: str, name_j: str) -> str:
     return f"/pairs/{name_i}-{name_j}/distance"
 
 
-def _set(target, values) -> None:
-    """Copy ``values`` into a message of fields x, y, z (w) or r, g, b, a, in order."""
-    for field, value in zip(type(target).DESCRIPTOR.fields, values):
-        setattr(target, field.name, float(value))
-
-
-def _sphere(entity, position, orientation, diameter: float, colour) -> None:
+def _sphere(entity, position: list[float], orientation: list[float], diameter: float, colour: tuple) -> None:
+    """Add a sphere: ``position`` (m), ``orientation`` ``(qw, qx, qy, qz)``, ``colour`` ``(r, g, b, a)``."""
     sphere = entity.spheres.add()
-    _set(sphere.pose.position, position)
-    _set(sphere.pose.orientation, orientation[[1, 2, 3, 0]])  # foxglove.Quaternion is (x, y, z, w)
-    _set(sphere.size, (diameter, diameter, diameter))
-    _set(sphere.color, colour)
+    place, turn = sphere.pose.position, sphere.pose.orientation
+    place.x, place.y, place.z = position
+    turn.w, turn.x, turn.y, turn.z = orientation
+    sphere.size.x = sphere.size.y = sphere.size.z = diameter
+    sphere.color.r, sphere.color.g, sphere.color.b, sphere.color.a = colour
 
 
-def _edges(entity, recording: Recording, f: int, columns: np.ndarray, coupled: bool) -> None:
-    """The pairs drawn (both agents recorded) with ``F_en`` as ``coupled``, as one list of line segments."""
+def _edges(entity, segments: list[tuple[list[float], list[float]]], colour: tuple) -> None:
+    """Add the ``segments`` (pairs of points, m) as one list of lines, ``colour`` ``(r, g, b, a)``."""
     from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 
-    chosen = np.flatnonzero((columns >= 0).all(axis=1) & ((recording.flags[f] == 1) == coupled))
-    if not chosen.size:
+    if not segments:
         return
     line = entity.lines.add()
     line.type = LinePrimitive.LINE_LIST
     line.thickness = 2.0
     line.scale_invariant = True  # pixels, whatever the zoom
-    _set(line.pose.orientation, (0.0, 0.0, 0.0, 1.0))
-    _set(line.color, COUPLED if coupled else UNCOUPLED)
-    for p in chosen:
-        for k in columns[p]:
-            _set(line.points.add(), recording.positions[f, k])
+    line.pose.orientation.w = 1.0
+    line.color.r, line.color.g, line.color.b, line.color.a = colour
+    for ends in segments:
+        for end in ends:
+            point = line.points.add()
+            point.x, point.y, point.z = end
 
 
 def _scene(recording: Recording, f: int, quaternions: np.ndarray, columns: np.ndarray, stamp: int):
@@ -96,21 +92,22 @@ def _scene(recording: Recording, f: int, quaternions: np.ndarray, columns: np.nd
     from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 
     update = SceneUpdate()
-    level = np.array([1.0, 0.0, 0.0, 0.0])
+    places, turns, flying = recording.positions[f].tolist(), quaternions[f].tolist(), recording.active[f].tolist()
+    body, reach = BODY_SHARE * recording.radius, 2.0 * recording.radius
     for k, name in enumerate(recording.names):
         entity = update.entities.add()
         entity.timestamp.FromNanoseconds(stamp)
         entity.frame_id, entity.id = FRAME_ID, name
-        flying = recording.active[f, k]
-        _sphere(entity, recording.positions[f, k], quaternions[f, k], BODY_SHARE * recording.radius, FLYING if flying else REMOVED)
-        if flying:
-            _sphere(entity, recording.positions[f, k], level, 2.0 * recording.radius, REACH)
+        _sphere(entity, places[k], turns[k], body, FLYING if flying[k] else REMOVED)
+        if flying[k]:
+            _sphere(entity, places[k], [1.0, 0.0, 0.0, 0.0], reach, REACH)
     if len(recording.pairs):
         entity = update.entities.add()
         entity.timestamp.FromNanoseconds(stamp)
         entity.frame_id, entity.id = FRAME_ID, "formation"
-        _edges(entity, recording, f, columns, coupled=True)
-        _edges(entity, recording, f, columns, coupled=False)
+        drawn = [(i, j, flag) for (i, j), flag in zip(columns.tolist(), recording.flags[f].tolist()) if i >= 0 and j >= 0]
+        _edges(entity, [(places[i], places[j]) for i, j, flag in drawn if flag == 1], COUPLED)
+        _edges(entity, [(places[i], places[j]) for i, j, flag in drawn if flag != 1], UNCOUPLED)
     return update
 
 
@@ -120,6 +117,12 @@ def _point(t: float, value: float):
     return Vector2(x=float(t), y=float(value))
 
 
+def _pair_topics(recording: Recording) -> list[str]:
+    """Each tracked pair's channel, in the pairs' order (an agent not recorded goes by its number)."""
+    names = dict(zip(recording.agents.tolist(), recording.names))
+    return [pair_topic(names.get(i, f"agent{i + 1}"), names.get(j, f"agent{j + 1}")) for i, j in recording.pairs.tolist()]
+
+
 def _channels(writer, recording: Recording) -> dict[str, int]:
     """Register every channel with its Foxglove schema; return the channel ids by topic."""
     from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
@@ -127,10 +130,7 @@ def _channels(writer, recording: Recording) -> dict[str, int]:
     from mcap_protobuf.schema import register_schema
 
     scene, point = register_schema(writer, SceneUpdate), register_schema(writer, Vector2)
-    names = dict(zip(recording.agents.tolist(), recording.names))
-    topics = {TOPIC_SCENE: scene, TOPIC_RMS: point}
-    for i, j in recording.pairs.tolist():
-        topics[pair_topic(names.get(i, f"agent{i + 1}"), names.get(j, f"agent{j + 1}"))] = point
+    topics = {TOPIC_SCENE: scene, TOPIC_RMS: point, **{topic: point for topic in _pair_topics(recording)}}
     return {topic: writer.register_channel(topic, "protobuf", schema) for topic, schema in topics.items()}
 
 
@@ -154,9 +154,9 @@ def write_mcap(recording: Recording, path: Path) -> None:
         writer.start(profile="", library=f"tmem {__version__} ({EXPORT_MARK})")
         writer.add_metadata("tmem", {"scenario": recording.scenario, "frame": FRAME, "frame_id": FRAME_ID})
         channels = _channels(writer, recording)
-        pair_channels = list(channels.values())[2:]
-        for r, t in enumerate(recording.time):
-            stamp = int(round(t * 1e9))
+        pair_channels = [channels[topic] for topic in _pair_topics(recording)]
+        stamps = np.round(recording.time * 1e9).astype(np.int64).tolist()
+        for r, (t, stamp) in enumerate(zip(recording.time.tolist(), stamps)):
             messages = [(channels[TOPIC_SCENE], _scene(recording, r, quaternions, columns, stamp)),
                         (channels[TOPIC_RMS], _point(t, recording.rms_velocity[r]))]  # fmt: skip
             messages += [(c, _point(t, recording.distances[r, p])) for p, c in enumerate(pair_channels)]
