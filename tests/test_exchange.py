@@ -274,3 +274,16 @@ def test_an_interrupted_export_leaves_nothing(triangle, tmp_path, monkeypatch, t
     with pytest.raises(KeyboardInterrupt):
         export(triangle[0], to, tmp_path / "out" / "export")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_swarm_without_tracked_pairs_exports_its_agents(tmp_path):
+    """40 agents under repulsion track no pair: the export has no pair channel and no formation."""
+    changes = {"simulation.duration": 10.0, "swarm.n": 40}  # 101 records
+    trajectory = tmem.simulate(with_changes(tmem.load(EXAMPLES / "swarm" / "gas2d.toml"), changes))
+    assert trajectory.pairs.shape == (0, 2) and len(trajectory.time) == 101
+    write_netcdf(trajectory, tmp_path / "trajectory.nc")
+    _, channels, messages = _read_mcap(export(tmp_path, "mcap"))
+    assert sorted(channels) == ["/metrics/rms_velocity", "/swarm"]
+    assert [len(scene.entities) for _, scene in messages["/swarm"]] == [40] * 101
+    _, table = _read_csv(export(tmp_path, "csv") / "agent40.csv")
+    np.testing.assert_array_equal(table[:, 1:3], trajectory.state[:, 39, :, 0])

@@ -78,6 +78,14 @@ def _padded(values: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
+def _over_time(ds, name: str, dtype: type) -> np.ndarray:
+    """A per-pair variable as ``(time, pair)``; none read when there are no pairs (h5netcdf fails to
+    read an empty variable over an unlimited dimension, as a dimension of length 0 is written)."""
+    if ds.sizes["pair"] == 0:
+        return np.zeros((ds.sizes["time"], 0), dtype=dtype)
+    return ds[name].transpose("time", "pair").values.astype(dtype)
+
+
 def _read(path: Path) -> Recording:
     with open_trajectory(path) as ds:
         if not str(ds.attrs.get("source", "")).startswith("tmem ") or "scenario" not in ds.attrs:
@@ -94,8 +102,8 @@ def _read(path: Path) -> Recording:
             tilts=_padded(components(ds, "phi"), 2),
             active=ds["active"].transpose("time", "agent").values.astype(bool),
             pairs=np.stack([ds["pair_i"].values, ds["pair_j"].values], axis=-1).astype(np.int64).reshape(-1, 2),
-            flags=ds["F_en"].transpose("time", "pair").values.astype(np.int8),
-            distances=ds["distance"].transpose("time", "pair").values.astype(float),
+            flags=_over_time(ds, "F_en", np.int8),
+            distances=_over_time(ds, "distance", float),
             rms_velocity=ds["rms_velocity"].values.astype(float),
             radius=float(tomllib.loads(scenario)["interaction"]["radius"]),
             n_axes=len(run_axes(ds)),
