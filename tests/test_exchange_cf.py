@@ -86,7 +86,9 @@ def test_the_file_declares_cf_trajectories(runs):
     with h5netcdf.File(runs[2][1], "r") as f:  # the attributes as any CF reader sees them
         for name in ("V_x", "phi_y", "U_x", "active"):
             assert set(f.variables[name].attrs["coordinates"].split()) >= {"x", "y", "agent_name"}
+            assert f.variables[name].attrs["grid_mapping"] == "crs"
         assert "_FillValue" not in f.variables["time"].attrs  # CF: coordinate variables have none
+        assert f.variables["crs"].attrs["grid_mapping_name"] == "orthographic"
     with open_trajectory(runs[3][1]) as ds:
         assert ds["z"].attrs["positive"] == "up" and ds["z"].attrs["axis"] == "Z"
 
@@ -120,3 +122,18 @@ def test_the_file_holds_the_runs_numbers(runs, axes):
         np.testing.assert_array_equal(ds["distance"].values.T, trajectory.pair_distance)
         if axes == 1:
             assert float(ds["y"]) == 0.0 and ds["y"].dims == ()
+
+
+def test_the_grid_mapping_puts_x_east_and_y_north_in_metres(runs):
+    """pyproj reads the CF grid mapping independently: 1 km along x is 1 km east of the placeholder origin."""
+    from pyproj import CRS, Geod, Transformer
+
+    with h5netcdf.File(runs[2][1], "r") as f:
+        crs = CRS.from_cf(dict(f.variables["crs"].attrs))
+    to_degrees = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
+    (lon_x, lon_y), (lat_x, lat_y) = to_degrees.transform([1000.0, 0.0], [0.0, 1000.0])
+    assert lon_x > 0.0 and lat_x == pytest.approx(0.0, abs=1e-9)  # x: east
+    assert lat_y > 0.0 and lon_y == pytest.approx(0.0, abs=1e-9)  # y: north
+    geod = Geod(ellps="WGS84")
+    assert geod.inv(0.0, 0.0, lon_x, lat_x)[2] == pytest.approx(1000.0, rel=1e-6)
+    assert geod.inv(0.0, 0.0, lon_y, lat_y)[2] == pytest.approx(1000.0, rel=1e-6)

@@ -25,7 +25,9 @@ from . import __version__, metrics, plot
 from .engine import Trajectory
 from .engine.gas import COLUMNS
 from .outputs import OutputError, check_directory, replace_directory
-from .trajectory_file import CONVENTIONS, FRAME, FRAME_AXES, OVER_AGENTS, OVER_PAIRS, POSITION_ATTRS, TIME_UNITS
+from .trajectory_file import (
+    CONVENTIONS, FRAME, FRAME_AXES, GRID_MAPPING, GRID_MAPPING_ATTRS, OVER_AGENTS, OVER_PAIRS, POSITION_ATTRS, TIME_UNITS,
+)  # fmt: skip
 
 __all__ = ["OutputError", "agent_names", "check_output_directory", "contents", "to_dataset", "write_netcdf", "write_run", "write_run_files"]
 
@@ -92,8 +94,9 @@ def contents(trajectory: Trajectory) -> Contents:
     ``time``.  Per agent, over (agent, time): the positions, as the coordinates
     ``x``, ``y``, ``z`` (as many as the run has axes; a 1-D run has ``y = 0``);
     the vehicle model's other states (``V``, ``phi``, ``omega``) and the control
-    ``U``, one variable per axis (``V_x``, ``V_y``...); ``active``.  The agents'
-    names (``agent_name``, the trajectories' id).  Per pair, over (pair, time):
+    ``U``, one variable per axis (``V_x``, ``V_y``...); ``active``; each names
+    the grid mapping ``crs`` (:data:`tmem.trajectory_file.GRID_MAPPING`).  The
+    agents' names (``agent_name``, the trajectories' id).  Per pair, over (pair, time):
     the coupling flag ``F_en``, the distance and the interaction distance
     ``|d|`` (6); each pair's set distance ``d_t``.  Over time: the RMS velocity
     of the recorded agents, and when the gas is observed its running totals
@@ -114,6 +117,9 @@ def contents(trajectory: Trajectory) -> Contents:
             data.update(_per_axis(name, trajectory.state[:, order][..., m], long_name, units))
     data.update(_per_axis("U", trajectory.control[:, order], "tilt set-point (control)", "rad"))
     data["active"] = (OVER_AGENTS, trajectory.active[:, order].T.astype(np.int8), {"long_name": "agent flying", "units": "1"})
+    for _, _, attrs in data.values():  # every per-agent variable is located in the frame
+        attrs["grid_mapping"] = GRID_MAPPING
+    data[GRID_MAPPING] = ((), np.array(0, dtype=np.int32), dict(GRID_MAPPING_ATTRS))
     data["F_en"] = (OVER_PAIRS, trajectory.flag.T.astype(np.int8), {"long_name": "pair coupling flag F_en", "units": "1"})
     data["distance"] = (OVER_PAIRS, trajectory.pair_distance.T, {"long_name": "distance |P_j - P_i|", "units": "m"})
     data["interaction_distance"] = (

@@ -4,8 +4,9 @@ A run's file follows CF's discrete sampling geometry for trajectories (CF 1.11, 
 Appendix H.4): one trajectory per recorded agent, all at the same times, in the multidimensional
 array representation.  Per agent, each record is a row over ``(agent, time)``, the order CF
 recommends (its section 2.4); the positions are the coordinates ``x``, ``y``, ``z`` of the run's
-local Cartesian frame (:data:`FRAME`), every other per-axis quantity one variable per axis
-(``V_x``, ``phi_y``, ``U_z``).  ``docs/exchange.md`` says why each choice was made.
+local Cartesian frame (:data:`FRAME`, tied to the Earth only by a placeholder grid mapping,
+:data:`GRID_MAPPING`), every other per-axis quantity one variable per axis (``V_x``, ``phi_y``,
+``U_z``).  ``docs/exchange.md`` says why each choice was made.
 
 This module holds the names the writer (:func:`tmem.io.contents`) and the readers share, and the
 readers' guard against files that are missing or damaged (:func:`read_run`); it loads nothing
@@ -36,10 +37,24 @@ FRAME_AXES = ("x", "y", "z")
 #: The frame and the clock, as the file's ``comment`` says them.
 FRAME = (
     "Positions are in the run's local Cartesian frame (metres, right-handed, z up): x and y span the "
-    "horizontal plane, z is the height above it; the frame is not tied to a place on the Earth. A 1-D run "
-    "flies along x (y = 0). Times are seconds from the start of the run, which stands at the reference "
-    "date of the time units."
+    "horizontal plane, z is the height above it; the frame is not tied to a place on the Earth, and the "
+    "origin of its grid mapping is a placeholder. A 1-D run flies along x (y = 0). Times are seconds from "
+    "the start of the run, which stands at the reference date of the time units."
 )
+#: CF asks that horizontal coordinates other than latitude and longitude be tied to the Earth by a
+#: grid mapping (its section 5.6).  The frame's x-y plane is the tangent plane at its origin (x east,
+#: y north): CF's orthographic projection about the origin.  A run has no place on the Earth, so the
+#: origin is a placeholder, 0 N 0 E, as the time units' date is; a user who knows the site sets it.
+GRID_MAPPING = "crs"
+GRID_MAPPING_ATTRS = {
+    "grid_mapping_name": "orthographic",
+    "latitude_of_projection_origin": 0.0,
+    "longitude_of_projection_origin": 0.0,
+    "false_easting": 0.0,
+    "false_northing": 0.0,
+    "comment": "the run's frame is local: its origin here is a placeholder; set the two origin attributes "
+    "to the site's to place the run on the Earth (x east, y north)",
+}
 #: The dimensions of what is recorded per agent and per pair: one row per agent (pair).
 OVER_AGENTS = ("agent", "time")
 OVER_PAIRS = ("pair", "time")
@@ -53,7 +68,7 @@ POSITION_ATTRS = {
 }
 
 __all__ = [
-    "CONVENTIONS", "FRAME", "FRAME_AXES", "OVER_AGENTS", "OVER_PAIRS", "POSITION_ATTRS", "TIME_UNITS", "Refused",
+    "CONVENTIONS", "FRAME", "FRAME_AXES", "GRID_MAPPING", "GRID_MAPPING_ATTRS", "OVER_AGENTS", "OVER_PAIRS", "POSITION_ATTRS", "TIME_UNITS", "Refused",
     "components", "open_trajectory", "positions", "read_run", "run_axes", "trajectory_path",
 ]  # fmt: skip
 
