@@ -287,3 +287,11 @@ def test_a_swarm_without_tracked_pairs_exports_its_agents(tmp_path):
     assert [len(scene.entities) for _, scene in messages["/swarm"]] == [40] * 101
     _, table = _read_csv(export(tmp_path, "csv") / "agent40.csv")
     np.testing.assert_array_equal(table[:, 1:3], trajectory.state[:, 39, :, 0])
+
+
+def test_a_run_that_recorded_no_agent_is_refused(tmp_path):
+    changes = {"simulation.duration": 2.0, "simulation.dt": 0.001, "commands": [], "simulation.record_agents": []}
+    write_netcdf(tmem.simulate(with_changes(tmem.preset("fig9"), changes)), tmp_path / "trajectory.nc")
+    with pytest.raises(ValueError, match=r"^export: .*trajectory\.nc: the run recorded no agent \(simulation\.record_agents = \[\]\); nothing to export$"):
+        export(tmp_path, "csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["trajectory.nc"]

@@ -79,8 +79,8 @@ def _padded(values: np.ndarray, width: int) -> np.ndarray:
 
 
 def _over_time(ds, name: str, dtype: type) -> np.ndarray:
-    """A per-pair variable as ``(time, pair)``; none read when there are no pairs (h5netcdf fails to
-    read an empty variable over an unlimited dimension, as a dimension of length 0 is written)."""
+    """A per-pair variable as ``(time, pair)``; none read when there are no pairs (reading an empty
+    variable through xarray's h5netcdf backend can fail in h5py's selection)."""
     if ds.sizes["pair"] == 0:
         return np.zeros((ds.sizes["time"], 0), dtype=dtype)
     return ds[name].transpose("time", "pair").values.astype(dtype)
@@ -93,6 +93,8 @@ def _read(path: Path) -> Recording:
         if ds.attrs.get("featureType") != "trajectory" or "agent_name" not in ds.variables:
             raise Refused(f"export: {path}: written by an earlier tmem (its layout is not CF trajectories); "
                           "run the scenario again")  # fmt: skip
+        if ds.sizes["agent"] == 0:
+            raise Refused(f"export: {path}: the run recorded no agent (simulation.record_agents = []); nothing to export")
         scenario = str(ds.attrs["scenario"])
         return Recording(
             time=ds["time"].values.astype(float),
@@ -123,6 +125,6 @@ def read_recording(run_dir: str | Path) -> Recording:
     ------
     ValueError
         In one line: no such folder, no ``trajectory.nc``, a file that cannot be read, a file of
-        an earlier tmem.
+        an earlier tmem, a run that recorded no agent.
     """
     return read_run(Path(run_dir), "export", _read)
