@@ -51,7 +51,7 @@ def labelled(ax, prefix: str) -> dict[str, object]:
 
 def per_axis(ds, *names: str) -> np.ndarray:
     """The variables ``names`` (one per axis: ``x``, ``y``; ``V_x``, ``V_y``), stacked as (time, agent, axis)."""
-    return np.stack([ds[name].transpose("time", "agent").values for name in names], axis=-1)
+    return np.stack([ds[name].transpose("time", ...).values for name in names], axis=-1)
 
 
 def agent_names(ds) -> set[str]:

@@ -163,7 +163,7 @@ def test_large_swarms_are_thinned_and_the_page_says_so(tmp_path):
     assert read_view(write_run(tmp_path / "small"), max_frames=None).note == ""
 
 
-def test_reading_a_block_of_frames_at_a_time_reads_the_same(tmp_path, monkeypatch):
+def test_reading_a_block_of_agents_at_a_time_reads_the_same(tmp_path, monkeypatch):
     run = write_run(tmp_path / "run", n_agents=7, n_times=50, pairs=((0, 1), (5, 6)))
     whole = read_view(run, max_agents=5, max_frames=20)
     monkeypatch.setattr(data, "_READ_VALUES", 9)  # an agent's record per block

@@ -270,12 +270,14 @@ def over_time(dataset, name: str) -> np.ndarray:
         values = np.zeros(variable.shape, dtype=variable.dtype)
     else:
         values = np.asarray(variable.values if hasattr(variable, "dims") else variable[...])
-    return np.moveaxis(values, dims.index("time"), 0) if "time" in dims else values
+    # In time-first memory order, as the run kept it: NumPy's sums then add in the same order, so that
+    # what is computed from a file read back (a figure's line) is what was computed from the run.
+    return np.ascontiguousarray(np.moveaxis(values, dims.index("time"), 0)) if "time" in dims else values
 
 
 def _stacked(dataset, names: list[str]) -> np.ndarray:
     """The variables ``names`` over ``(agent, time)``, stacked as one array ``(time, agent, axis)``."""
-    return np.stack([over_time(dataset, name) for name in names], axis=-1).astype(float)
+    return np.stack([over_time(dataset, name) for name in names], axis=-1).astype(float, copy=False)
 
 
 def positions(dataset) -> np.ndarray:

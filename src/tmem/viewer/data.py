@@ -36,7 +36,7 @@ MAX_EDGES = 3000
 #: Most pairs drawn one line each in the distance panel; more are drawn as their
 #: smallest, median and largest distance.
 MAX_PAIR_LINES = 60
-#: Most values read from the file at once (a block of frames of a large swarm).
+#: Most values read from the file at once (a block of agents' records of a large swarm).
 _READ_VALUES = 20_000_000
 #: Codes of an agent's state in :attr:`View.status`.
 WAITING, FLYING, REMOVED = 0, 1, 2
