@@ -12,37 +12,42 @@ from PIL import Image, ImageChops
 from tmem.animate import animate
 from tmem.animate.frames import read_frames
 from tmem.animate.scene import positions, scene, update
+from tmem.trajectory_file import FRAME_AXES, OVER_AGENTS, OVER_PAIRS, TIME_UNITS
 
 SCENARIO = 'name = "synthetic"\n\n[interaction]\nradius = 20.0\nd_t = 35.0\n'
 
 
 def _dataset(n_times=30, n_axes=2, agents=(0, 1, 2), pairs=((0, 1),), active=True, d_t=True):
-    """Agents on straight lines, the pairs coupling halfway, the last agent removed at two thirds."""
+    """Agents on straight lines, the pairs coupling halfway, the last agent removed at two thirds.
+
+    Laid out as ``trajectory.nc`` is (:mod:`tmem.trajectory_file`): per agent over (agent, time),
+    the positions as the coordinates x, y, z (a 1-D run with y = 0), a variable per axis.
+    """
     n = len(agents)
     time = 0.5 * np.arange(n_times)
     start = np.array([[0.0, 0.0, 0.0], [80.0, 10.0, 0.0], [40.0, -50.0, 0.0]] * n)[:n, :n_axes]
     velocity = np.array([[2.0, 0.5, 0.0], [-2.0, 0.0, 0.0], [0.0, 1.0, 0.0]] * n)[:n, :n_axes]
-    P = start + time[:, None, None] * velocity
+    P = start[:, None, :] + time[None, :, None] * velocity[:, None, :]  # (agent, time, axis)
     pairs = np.array(pairs, dtype=int).reshape(-1, 2)
-    flag = np.zeros((n_times, len(pairs)), np.int8)
-    flag[n_times // 2 :] = 1
-    zeros = np.zeros_like(P)
-    data = {name: (("time", "agent", "axis"), value) for name, value in (("P", P), ("V", zeros), ("U", zeros))}
-    data["F_en"] = (("time", "pair"), flag)
+    flag = np.zeros((len(pairs), n_times), np.int8)
+    flag[:, n_times // 2 :] = 1
+    data = {f"{name}_{axis}": (OVER_AGENTS, np.zeros((n, n_times))) for name in ("V", "U") for axis in FRAME_AXES[:n_axes]}
+    data["F_en"] = (OVER_PAIRS, flag)
     if active:
-        alive = np.ones((n_times, n), np.int8)
-        alive[2 * n_times // 3 :, n - 1] = 0
-        data["active"] = (("time", "agent"), alive)
+        alive = np.ones((n, n_times), np.int8)
+        alive[n - 1, 2 * n_times // 3 :] = 0
+        data["active"] = (OVER_AGENTS, alive)
     if d_t:
         data["d_t"] = ("pair", np.full(len(pairs), 35.0))
     coords = {
-        "time": ("time", time, {"units": "s"}),
+        "time": ("time", time, {"units": TIME_UNITS}),
         "agent": np.asarray(agents),
-        "axis": ["x", "y", "z"][:n_axes],
         "pair": np.arange(len(pairs)),
         "pair_i": ("pair", pairs[:, 0]),
         "pair_j": ("pair", pairs[:, 1]),
     }
+    for a, axis in enumerate(FRAME_AXES[: max(n_axes, 2)]):
+        coords[axis] = (OVER_AGENTS, P[..., a]) if a < n_axes else ((), 0.0)
     return xr.Dataset(data, coords=coords, attrs={"scenario": SCENARIO})
 
 
@@ -120,9 +125,9 @@ def test_strain_scale_is_fitted_to_the_coupled_pairs_drawn(tmp_path):
     run = _write(tmp_path)
     frames = read_frames(run, max_frames=400)
     _, moving = scene(frames, positions(frames)[0], dpi=40)
-    P = ds["P"].values
-    coupled = ds["F_en"].values[:, 0] == 1
-    strain = np.linalg.norm(P[coupled, 1] - P[coupled, 0], axis=1) / 35.0 - 1
+    P = np.stack([ds["x"].values, ds["y"].values], axis=-1)  # (agent, time, axis)
+    coupled = ds["F_en"].values[0] == 1
+    strain = np.linalg.norm(P[1, coupled] - P[0, coupled], axis=1) / 35.0 - 1
     assert moving["coupled"].norm.vmax == pytest.approx(np.abs(strain).max(), rel=1e-12)
     assert moving["coupled"].norm.vmin == -moving["coupled"].norm.vmax
 

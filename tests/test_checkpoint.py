@@ -188,12 +188,15 @@ def run_cli(*args):
 
 
 def nc_variables(path: Path) -> dict:
-    """Every variable's values (as bytes) and every attribute of a trajectory.nc."""
+    """Every variable's values (as bytes; strings, such as the agents' names, as the bytes they hold)
+    and every attribute of a trajectory.nc."""
     found = {}
     with h5py.File(path, "r") as f:
         found["attrs"] = {k: np.asarray(v).tobytes() for k, v in f.attrs.items()}
         for name, variable in f.items():
-            found[name] = (variable.dtype.str, variable.shape, variable[()].tobytes())
+            values = variable[()]
+            held = b"\0".join(values.ravel().tolist()) if values.dtype.kind == "O" else values.tobytes()
+            found[name] = (variable.dtype.str, variable.shape, held)
     return found
 
 

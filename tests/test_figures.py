@@ -24,12 +24,13 @@ SHORT = {"simulation.duration": 3.0, "simulation.record_every": 1000}  # 31 reco
 
 @pytest.fixture(scope="module")
 def hex19(tmp_path_factory):
-    """examples/swarm/hex19.toml, 3 s of it: its trajectory, its run directory and its file opened with xarray."""
+    """examples/swarm/hex19.toml, 3 s of it: its trajectory, its run directory and its file opened with xarray
+    (every variable with time first; the file keeps one row per agent or pair, CF trajectories)."""
     trajectory = tmem.simulate(with_changes(load(EXAMPLES / "swarm" / "hex19.toml"), SHORT))
     out = tmp_path_factory.mktemp("hex19") / "run"
     write_run(trajectory, out)
-    with xr.open_dataset(out / "trajectory.nc", engine="h5netcdf") as ds:
-        yield trajectory, out, ds.load()
+    with xr.open_dataset(out / "trajectory.nc", engine="h5netcdf", decode_times=False) as ds:
+        yield trajectory, out, ds.load().transpose("time", ...)
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +49,11 @@ def labelled(ax, prefix: str) -> dict[str, object]:
     return {line.get_label(): line for line in ax.get_lines() if line.get_label().startswith(prefix)}
 
 
+def per_axis(ds, *names: str) -> np.ndarray:
+    """The variables ``names`` (one per axis: ``x``, ``y``; ``V_x``, ``V_y``), stacked as (time, agent, axis)."""
+    return np.stack([ds[name].transpose("time", ...).values for name in names], axis=-1)
+
+
 def agent_names(ds) -> set[str]:
     return {f"agent {a + 1}" for a in ds["agent"].values}
 
@@ -63,7 +69,7 @@ def test_velocity_draws_every_agent_numbered_from_one(hex19):
     ax = figures_of(trajectory)["velocity.png"](trajectory).axes[0]
     lines = labelled(ax, "agent ")
     assert set(lines) == agent_names(ds) and len(lines) == 19
-    speed = np.linalg.norm(ds["V"].sel(agent=6).values, axis=1)  # index 6 in the file is agent 7
+    speed = np.linalg.norm(per_axis(ds.sel(agent=6), "V_x", "V_y"), axis=-1)  # index 6 in the file is agent 7
     np.testing.assert_allclose(lines["agent 7"].get_ydata(), speed, rtol=1e-12)
     assert "\n" not in ax.get_title()  # every agent drawn: no note
 
@@ -97,7 +103,7 @@ def test_paths_draw_every_agent_and_number_them(hex19):
     ax = figures_of(trajectory)["paths.png"](trajectory).axes[0]
     lines = labelled(ax, "agent ")
     assert set(lines) == agent_names(ds)
-    np.testing.assert_allclose(lines["agent 19"].get_xydata(), ds["P"].sel(agent=18).values, rtol=1e-12)
+    np.testing.assert_allclose(lines["agent 19"].get_xydata(), per_axis(ds.sel(agent=18), "x", "y"), rtol=1e-12)
     numbers = sorted(int(t.get_text()) for t in ax.texts)
     assert numbers == list(range(1, 20))
 
@@ -112,7 +118,7 @@ def test_shape_shows_every_agent_and_pair_with_the_strain_scale_of_the_run(hex19
     assert 0.01 < largest < 0.1
     for ax, (_, record) in zip(panels, moments(trajectory)):
         dots = next(c for c in ax.collections if isinstance(c, PathCollection))
-        np.testing.assert_allclose(dots.get_offsets(), ds["P"].values[record], rtol=1e-12)
+        np.testing.assert_allclose(dots.get_offsets(), per_axis(ds, "x", "y")[record], rtol=1e-12)
         solid = next(c for c in ax.collections if isinstance(c, LineCollection) and c.get_array() is not None)
         assert len(solid.get_segments()) == int((ds["F_en"].values[record] == 1).sum()) == 42
         np.testing.assert_allclose(solid.get_array(), strain.values[record], rtol=1e-9)
@@ -150,8 +156,8 @@ def test_moments_are_start_coupling_uncoupling_end(triangle_3d):
 
 def test_a_3d_run_is_drawn_in_3d_beside_its_projection(triangle_3d):
     trajectory, out = triangle_3d
-    with xr.open_dataset(out / "trajectory.nc", engine="h5netcdf") as ds:
-        position = ds["P"].values
+    with xr.open_dataset(out / "trajectory.nc", engine="h5netcdf", decode_times=False) as ds:
+        position = per_axis(ds, "x", "y", "z")
     paths = figures_of(trajectory)["paths.png"](trajectory)
     space = next(ax for ax in paths.axes if ax.name == "3d")
     plane = next(ax for ax in paths.axes if ax.name == "rectilinear" and ax.get_title() == "projection on (x, y)")

@@ -393,11 +393,12 @@ def test_a_field_run_writes_the_gas_and_coverage(tmp_path):
     a count of the cells the recorded positions pass through."""
     import json
 
-    import xarray as xr
     from typer.testing import CliRunner
 
     from tmem.cli import app
     from tmem.coverage import coverage
+    from tmem.trajectory_file import open_trajectory
+    from tmem.trajectory_file import positions as recorded_positions
 
     base = Path(__file__).parent.parent / "examples" / "swarm" / "field.toml"
     scenario = tmem.scenario.with_changes(tmem.load(base), {"swarm.n": 12, "simulation.duration": 60.0})
@@ -410,9 +411,9 @@ def test_a_field_run_writes_the_gas_and_coverage(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["gas"]["breaches"] == 0
     assert summary["gas"]["rms_velocity"] == pytest.approx(3.0, rel=0.1)
-    with xr.open_dataset(out / "trajectory.nc", engine="h5netcdf") as ds:
+    with open_trajectory(out / "trajectory.nc") as ds:
         assert ds["gas_flying"].values[-1] == 12
-        positions, time = ds["P"].values, ds["time"].values
+        positions, time = recorded_positions(ds), ds["time"].values
     plain = coverage(positions, time, np.ones(positions.shape[:2], bool), [1000.0, 1000.0], 20.0,
                      [(o.center, o.radius) for o in scenario.obstacles], 25.0, periodic=False)  # fmt: skip
     assert summary["coverage"]["share_final"] == pytest.approx(plain.share[-1])

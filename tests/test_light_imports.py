@@ -40,7 +40,7 @@ def test_the_command_line_module_loads_nothing_heavy():
     assert loaded_after("import tmem.cli") == set()
 
 
-@pytest.mark.parametrize("args", [["--help"], ["--version"], ["run", "--help"], ["sweep", "--help"], ["plot", "--help"]])
+@pytest.mark.parametrize("args", [["--help"], ["--version"], ["run", "--help"], ["sweep", "--help"], ["plot", "--help"], ["export", "--help"]])
 def test_help_works_and_loads_nothing_heavy(args):
     code = f"import sys; sys.argv = ['tmem', *{args!r}]\nfrom tmem.cli import main\ntry:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code"
     assert loaded_after(code) == set()

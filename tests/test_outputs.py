@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 import tmem
 from tmem.cli import app
 from tmem.metrics import rms_velocity
+from tmem.trajectory_file import components, open_trajectory, positions
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 REQUIRED = {
@@ -51,23 +52,28 @@ def test_summary_has_the_promised_keys_and_values(fig9_run):
 
 def test_dataset_matches_summary_and_carries_units_and_scenario(fig9_run):
     s = json.loads((fig9_run / "summary.json").read_text())
-    with xr.open_dataset(fig9_run / "trajectory.nc", engine="h5netcdf") as ds:
-        assert dict(ds.sizes) == {"time": 6001, "agent": 2, "axis": 1, "pair": 1}
-        for name in ("P", "V", "phi", "omega", "U"):
-            assert ds[name].dims == ("time", "agent", "axis")
-        assert ds["F_en"].dims == ("time", "pair")
-        units = {name: ds[name].attrs["units"] for name in ("P", "V", "phi", "omega", "U", "distance")}
-        assert units == {"P": "m", "V": "m s-1", "phi": "rad", "omega": "rad s-1", "U": "rad", "distance": "m"}
-        assert ds["time"].attrs["units"] == "s"
-        rms = rms_velocity(ds["V"].values)
+    with open_trajectory(fig9_run / "trajectory.nc") as ds:
+        assert dict(ds.sizes) == {"time": 6001, "agent": 2, "pair": 1}
+        for name in ("x", "V_x", "phi_x", "omega_x", "U_x", "active"):
+            assert ds[name].dims == ("agent", "time")
+        assert ds["F_en"].dims == ("pair", "time")
+        assert ds["y"].dims == () and float(ds["y"]) == 0.0  # a 1-D run flies along x
+        units = {name: ds[name].attrs["units"] for name in ("x", "V_x", "phi_x", "omega_x", "U_x", "distance")}
+        assert units == {"x": "m", "V_x": "m s-1", "phi_x": "rad", "omega_x": "rad s-1", "U_x": "rad", "distance": "m"}
+        assert ds["time"].attrs["units"] == "seconds since 1970-01-01 00:00:00"
+        assert ds["time"].values[-1] == pytest.approx(60.0)
+        assert ds["agent_name"].values.tolist() == ["agent1", "agent2"]
+        rms = rms_velocity(components(ds, "V"))
         assert rms[0] == pytest.approx(s["rms_velocity_initial"], rel=1e-15)
         assert rms[-1] == pytest.approx(s["rms_velocity_final"], rel=1e-15)
-        np.testing.assert_allclose(ds["distance"].values[-1, 0], s["final_distance"], rtol=1e-15)
+        final = positions(ds)[-1, :, 0]
+        np.testing.assert_allclose(abs(final[1] - final[0]), s["final_distance"], rtol=1e-12)
+        np.testing.assert_allclose(ds["distance"].values[0, -1], s["final_distance"], rtol=1e-15)
         np.testing.assert_allclose(ds.attrs["gains"], s["gains"], rtol=1e-15)
         # The stored scenario is the one that ran.
         assert tmem.loads(ds.attrs["scenario"]) == tmem.load(EXAMPLES / "fig9.toml")
         # The flag is 1 exactly between the couple and uncouple events.
-        coupled = ds["time"].values[ds["F_en"].values[:, 0] == 1]
+        coupled = ds["time"].values[ds["F_en"].values[0, :] == 1]
         assert coupled.min() == pytest.approx(s["couple_time"], abs=0.01)
         assert coupled.max() == pytest.approx(s["uncouple_time"], abs=0.01)
 
@@ -83,7 +89,8 @@ def test_trajectory_file_reads_back_as_xarray_writes_it(scenario, tmp_path):
     with xr.open_dataset(tmp_path / "by_xarray.nc", engine="h5netcdf") as expected, \
             xr.open_dataset(tmp_path / "by_tmem.nc", engine="h5netcdf") as got:  # fmt: skip
         xr.testing.assert_identical(got, expected)
-        assert set(got.coords) == {"time", "agent", "axis", "pair", "pair_i", "pair_j"}
+        # Both runs have x and y: the ring flies in 2-D, and a 1-D run along x (y = 0).
+        assert set(got.coords) == {"time", "agent", "agent_name", "x", "y", "pair", "pair_i", "pair_j"}
         for name in list(expected.variables):
             assert got[name].dtype == expected[name].dtype, name
             assert got[name].encoding.get("dtype") == expected[name].encoding.get("dtype"), name

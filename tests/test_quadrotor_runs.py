@@ -59,8 +59,8 @@ def test_the_body_state_is_recorded_and_written(runs):
     np.testing.assert_allclose(np.linalg.norm(quaternion, axis=-1), 1.0, atol=1e-12)
     written = contents(trajectory).data
     dims, values, attrs = written["height"]
-    assert dims == ("time", "agent") and attrs["units"] == "m"
-    np.testing.assert_array_equal(values, height)
+    assert dims == ("agent", "time") and attrs["units"] == "m"  # a CF trajectory per agent
+    np.testing.assert_array_equal(values, height.T)
     assert written["rotor_1"][2]["units"] == "rad s-1"
 
 

@@ -22,7 +22,7 @@ from tmem.cli import app
 from tmem.model.linear import LinearModel
 from tmem.viewer import default_out, write_view
 from tmem.drawing import STRAIN_FLOOR
-from tmem.saved import RunReadError
+from tmem.trajectory_file import RunReadError
 from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, agent_status, read_view, strain_scale
 from tmem.viewer import data
 from tmem.viewer.page import VIEW_MARK, headline, quantised
@@ -51,20 +51,25 @@ def write_run(directory: Path, n_agents=3, n_times=30, n_axes=2, pairs=((0, 1), 
     if removed:
         active[2 * n_times // 3 :, n_agents - 1] = 0
         position[2 * n_times // 3 :, n_agents - 1] = position[2 * n_times // 3 - 1, n_agents - 1]  # stopped, as the engine holds it
-    over = ("time", "agent", "axis")
-    zeros = np.zeros_like(position)
-    data = {names[0]: (over, position), names[1]: (over, np.broadcast_to(velocity, position.shape)),
-            names[2]: (over, zeros), names[3]: (over, zeros), "U": (over, zeros)}  # fmt: skip
+    # Laid out as tmem run writes it (CF trajectories): per agent over (agent, time), the positions as
+    # the coordinates x, y (z), every other per-axis state one variable per axis (V_x, V_y...).
+    axes = ["x", "y", "z"][:n_axes]
+    over = ("agent", "time")
+    rows = position.transpose(1, 0, 2)  # (agent, time, axis)
+    zeros = np.zeros((n_agents, n_times))
+    data = {f"{name}_{axis}": (over, zeros) for name in (*names[2:], "U") for axis in axes}
+    data |= {f"{names[1]}_{axis}": (over, np.broadcast_to(velocity[:, a, None], zeros.shape)) for a, axis in enumerate(axes)}
     data |= {
-        "active": (("time", "agent"), active),
-        "F_en": (("time", "pair"), flag),
-        "distance": (("time", "pair"), distance),
-        "interaction_distance": (("time", "pair"), distance),
+        "active": (over, active.T),
+        "F_en": (("pair", "time"), flag.T),
+        "distance": (("pair", "time"), distance.T),
+        "interaction_distance": (("pair", "time"), distance.T),
         "d_t": ("pair", np.full(len(pairs), 35.0)),
         "rms_velocity": ("time", np.sqrt((velocity**2).sum(-1).mean()) * np.ones(n_times)),
     }
-    coords = {"time": time, "agent": np.arange(n_agents), "axis": ["x", "y", "z"][:n_axes], "pair": np.arange(len(pairs)),
+    coords = {"time": time, "agent": np.arange(n_agents), "pair": np.arange(len(pairs)),
               "pair_i": ("pair", pairs[:, 0]), "pair_j": ("pair", pairs[:, 1])}  # fmt: skip
+    coords |= {axis: (over, rows[..., a]) for a, axis in enumerate(axes)}
     xr.Dataset(data, coords=coords, attrs={"scenario": scenario_text(n_agents, n_axes, name)}).to_netcdf(
         directory / "trajectory.nc", engine="h5netcdf"
     )
@@ -93,7 +98,7 @@ def test_positions_in_the_page_match_the_file_to_the_16_bit_step(tmp_path):
     page = write_view(run, tmp_path / "view.html")
     shown = embedded(page)
     with xr.open_dataset(run / "trajectory.nc", engine="h5netcdf") as ds:
-        expected = ds["P"].values
+        expected = np.stack([ds["x"].values, ds["y"].values], axis=-1).transpose(1, 0, 2)  # (time, agent, axis)
         np.testing.assert_array_equal(shown["time"], ds["time"].values)
     step = (expected.max(axis=(0, 1)) - expected.min(axis=(0, 1))) / 65535
     assert np.all(np.abs(shown["position"] - expected) <= step / 2 + 1e-9)
@@ -158,14 +163,14 @@ def test_large_swarms_are_thinned_and_the_page_says_so(tmp_path):
     assert read_view(write_run(tmp_path / "small"), max_frames=None).note == ""
 
 
-def test_reading_a_block_of_frames_at_a_time_reads_the_same(tmp_path, monkeypatch):
+def test_reading_a_block_of_agents_at_a_time_reads_the_same(tmp_path, monkeypatch):
     run = write_run(tmp_path / "run", n_agents=7, n_times=50, pairs=((0, 1), (5, 6)))
     whole = read_view(run, max_agents=5, max_frames=20)
-    monkeypatch.setattr(data, "_READ_VALUES", 9)  # a frame or so per block
+    monkeypatch.setattr(data, "_READ_VALUES", 9)  # an agent's record per block
     blocks = read_view(run, max_agents=5, max_frames=20)
     for name in ("time", "position", "speed", "status", "strain", "coupled", "rms", "pair_distance"):
         np.testing.assert_array_equal(getattr(blocks, name), getattr(whole, name), err_msg=name)
-    every = read_view(run, max_frames=50)  # every frame: read in slices
+    every = read_view(run, max_frames=50)  # every agent: read in slices
     monkeypatch.setattr(data, "_READ_VALUES", 10**9)
     np.testing.assert_array_equal(every.position, read_view(run, max_frames=50).position)
 
@@ -174,7 +179,7 @@ def test_state_names_come_from_the_vehicle_model(tmp_path, monkeypatch):
     monkeypatch.setattr(LinearModel, "state_names", ("X", "Xdot", "tilt", "tilt_rate"))
     view = read_view(write_run(tmp_path / "renamed", names=("X", "Xdot", "tilt", "tilt_rate"), removed=False))
     assert view.position.shape == (30, 3, 2)
-    with pytest.raises(RunReadError, match=r"cannot be read as a run's trajectory \(.*X"):
+    with pytest.raises(RunReadError, match=r"cannot be read as a run's trajectory \(.*Xdot_x"):
         read_view(write_run(tmp_path / "usual", removed=False))
 
 

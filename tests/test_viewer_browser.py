@@ -125,11 +125,22 @@ def open_view(browser):
         viewer.close()
 
 
+def open_file(run: Path) -> xr.Dataset:
+    """The run's trajectory file, times in seconds (CF trajectories: a row per agent over time)."""
+    return xr.open_dataset(run / "trajectory.nc", engine="h5netcdf", decode_times=False)
+
+
+def file_positions(ds: xr.Dataset) -> np.ndarray:
+    """The positions, (time, agent, axis): the coordinates x, y, z over (agent, time) that the run has."""
+    axes = [a for a in ("x", "y", "z") if a in ds.variables and ds[a].dims == ("agent", "time")]
+    return np.stack([ds[a].values.T for a in axes], axis=-1)
+
+
 def positions_in_file(run: Path, t: float) -> dict[int, np.ndarray]:
     """Each agent's position at time ``t`` as the trajectory file holds it, keyed by its number from 1."""
-    with xr.open_dataset(run / "trajectory.nc", engine="h5netcdf") as ds:
+    with open_file(run) as ds:
         k = int(np.flatnonzero(ds["time"].values == t)[0])
-        return {int(a) + 1: ds["P"].values[k, q] for q, a in enumerate(ds["agent"].values)}
+        return {int(a) + 1: file_positions(ds)[k, q] for q, a in enumerate(ds["agent"].values)}
 
 
 def assert_drawn_as_in_file(viewer, run: Path):
@@ -265,9 +276,9 @@ def test_a_removed_agent_is_shown_removed_where_it_stopped(open_view, runs, tmp_
     removed = [a for a in viewer.drawn() if not a["flying"]]
     assert [a["agent"] for a in removed] == [4]  # the scenario's agent 3, numbered from 1
     assert_drawn_as_in_file(viewer, run)
-    with xr.open_dataset(run / "trajectory.nc", engine="h5netcdf") as ds:
-        stopped = int(np.flatnonzero(ds["active"].values[:, 3] == 0)[0])
-        np.testing.assert_allclose(removed[0]["position"], ds["P"].values[stopped, 3], atol=0.01)  # where it stopped
+    with open_file(run) as ds:
+        stopped = int(np.flatnonzero(ds["active"].values[3] == 0)[0])
+        np.testing.assert_allclose(removed[0]["position"], file_positions(ds)[stopped, 3], atol=0.01)  # where it stopped
     image = viewer.screenshot(tmp_path / "ring.png")
     assert pixels_near(image, REMOVED, tolerance=12) > 20
 

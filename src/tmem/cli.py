@@ -1,4 +1,4 @@
-"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` or ``plot`` a run, ``sweep`` many.
+"""The ``tmem`` command: ``run`` a scenario, reproduce the ``paper``, ``animate`` or ``plot`` a run, ``sweep`` many, ``export`` a run.
 
 User mistakes (a bad scenario, an unusable output directory) end with one
 line on standard error naming the field and the reason, exit status 2 and no
@@ -289,6 +289,33 @@ def plot_command(
         _say(f"{run_dir}: the run recorded nothing to draw")
         return
     _say(f"written {', '.join(p.name for p in paths)} to {paths[0].parent}/")
+
+
+@app.command("export")
+def export_command(
+    run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run`."),
+    to: str = typer.Option(..., "--to", help="mcap: Foxglove's messages in one file; csv: Crazyswarm2-style, a file per agent."),
+    out: Path = typer.Option(None, "--out", "-o", help="Where to write; default RUN_DIR/trajectory.mcap or RUN_DIR/crazyswarm/."),
+) -> None:
+    """Export a run for the field's tools: an MCAP file for Foxglove, or CSV files for Crazyswarm2.
+
+    \f
+    Parameters
+    ----------
+    run_dir : Path
+        A run directory written by ``tmem run``.
+    to : str
+        ``mcap`` or ``csv`` (``docs/exchange.md``).
+    out : Path or None
+        Where to write; default ``RUN_DIR/trajectory.mcap`` or ``RUN_DIR/crazyswarm/``.
+    """
+    from .exchange import export
+
+    try:
+        path = export(run_dir, to, out)
+    except (ValueError, OSError) as exc:
+        _fail(str(exc))
+    _say(f"written {path}")
 
 
 @app.command("sweep")

@@ -36,8 +36,9 @@ from .drawing import (
 from .engine import Trajectory
 from .observables import temperature
 from .outputs import check_directory, replace_directory, update_files
-from .saved import read_run, run_directory
+from .saved import read_run
 from .shape_plot import paths_figure, shape_figure
+from .trajectory_file import run_directory
 
 #: Matplotlib's warning for a character its font lacks (a name in CJK, an emoji).
 MISSING_GLYPH = r"Glyph \d+ .* missing from font"
@@ -294,7 +295,7 @@ def redraw(run_dir: str | Path, out: str | Path | None = None) -> list[Path]:
     ------
     ValueError
         In one line: a folder that is not a run, a damaged file, an ``out`` that may not be written
-        (:class:`tmem.saved.RunReadError`, :class:`tmem.outputs.OutputError`).
+        (:class:`tmem.trajectory_file.RunReadError`, :class:`tmem.outputs.OutputError`).
     """
     run_dir = run_directory(run_dir, "plot")
     in_place = out is None or Path(out).resolve() == run_dir.resolve()

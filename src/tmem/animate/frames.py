@@ -7,10 +7,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from ..drawing import columns_of, evenly
-from ..saved import RunReadError, reading, trajectory_file
+from ..trajectory_file import RunReadError, check_layout, open_trajectory, over_time, positions, reading, run_axes, trajectory_path
 
 #: Most agents drawn; larger runs are thinned evenly to this many.
 MAX_AGENTS_DRAWN = 3000
@@ -80,16 +79,16 @@ def read_frames(run_dir: str | Path, max_frames: int) -> Frames:
 
     Raises
     ------
-    tmem.saved.RunReadError
+    tmem.trajectory_file.RunReadError
         In one line: no such folder or file, a damaged or truncated file, a run on one axis, one
         with nothing recorded, a scenario without ``interaction.radius``.
     """
-    path = trajectory_file(run_dir, "animate")
+    path = trajectory_path(run_dir, "animate")
     with reading(path, "animate"):
         return _read(path, max_frames)
 
 
-def _scenario(ds: xr.Dataset, path: Path) -> tuple[dict, float]:
+def _scenario(ds, path: Path) -> tuple[dict, float]:
     try:
         scenario = tomllib.loads(ds.attrs["scenario"])
         return scenario, float(scenario["interaction"]["radius"])
@@ -99,8 +98,9 @@ def _scenario(ds: xr.Dataset, path: Path) -> tuple[dict, float]:
 
 def _read(path: Path, max_frames: int) -> Frames:
     """Read the frames and agents to draw from ``path``; refuse runs on one axis."""
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        n_axes = ds.sizes.get("axis", 0)
+    with open_trajectory(path) as ds:
+        check_layout(ds, path, "animate")
+        n_axes = len(run_axes(ds))
         if n_axes not in (2, 3):
             noun = "axis" if n_axes == 1 else "axes"
             raise RunReadError(f"animate: the run has {n_axes} {noun}; only 2-D and 3-D runs can be animated")
@@ -109,8 +109,8 @@ def _read(path: Path, max_frames: int) -> Frames:
         scenario, radius = _scenario(ds, path)
         drawn = evenly(ds.sizes["agent"], MAX_AGENTS_DRAWN, "agents")
         sub = ds.isel(time=evenly(ds.sizes["time"], max_frames, "frames").index, agent=drawn.index)
-        pos = sub["P"].values.astype(float)
-        active = sub["active"].values.astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
+        pos = positions(sub)
+        active = over_time(sub, "active").astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
         # Pairs whose two agents are both drawn (``pair_i``/``pair_j`` hold agent indices).
         col_i, ok_i = columns_of(sub["agent"].values, ds["pair_i"].values)
         col_j, ok_j = columns_of(sub["agent"].values, ds["pair_j"].values)
@@ -123,7 +123,7 @@ def _read(path: Path, max_frames: int) -> Frames:
             time=sub["time"].values.astype(float), pos=pos, active=active,
             agents=sub["agent"].values.astype(np.int64), agents_note=drawn.note,
             col_i=col_i[kept], col_j=col_j[kept],
-            flag=sub["F_en"].isel(pair=kept).values if kept.size else np.zeros((sub.sizes["time"], 0), np.int8),
+            flag=over_time(sub.isel(pair=kept), "F_en"),
             d_t=d_t, radius=radius, name=str(scenario.get("name", "")),
             box=scenario["space"]["box"] if scenario.get("space", {}).get("walls") else None,
             obstacles=[(o["center"], o["radius"]) for o in scenario.get("obstacles", [])],

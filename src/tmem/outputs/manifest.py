@@ -21,7 +21,7 @@ MANIFEST = ".tmem-output.json"
 #: The lock file of a directory being written by a long command (a sweep).
 LOCK = ".tmem-lock"
 #: Commands that write output directories, as their manifests name them.
-COMMANDS = ("run", "paper", "sweep", "plot")
+COMMANDS = ("run", "paper", "sweep", "plot", "export")
 #: Entries of an output directory that are tmem's bookkeeping, not its products.
 _BOOKKEEPING = frozenset({MANIFEST, LOCK})
 #: The largest manifest read (bytes).

@@ -18,6 +18,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from . import crazyflies
 from .schema import Scenario
 from .tables import MODEL_KINDS, FieldError, ScenarioError
 
@@ -148,7 +149,7 @@ def load(path: str | Path) -> Scenario:
         The scenario file.
     """
     path = Path(path)
-    return loads(read_text(path, "scenario", ScenarioError), source=str(path))
+    return loads(read_text(path, "scenario", ScenarioError), source=str(path), directory=path.parent)
 
 
 def parse_toml(text: str, source: str, error: type[ValueError]) -> dict:
@@ -171,7 +172,7 @@ def parse_toml(text: str, source: str, error: type[ValueError]) -> dict:
         raise error(f"{source}: TOML nested too deeply (arrays or inline tables inside one another)") from None
 
 
-def loads(text: str, source: str = "<scenario>") -> Scenario:
+def loads(text: str, source: str = "<scenario>", directory: Path | None = None) -> Scenario:
     """Parse and validate scenario TOML text; raise :class:`ScenarioError`.
 
     Parameters
@@ -180,6 +181,9 @@ def loads(text: str, source: str = "<scenario>") -> Scenario:
         The scenario, in TOML.
     source : str
         Where the text came from, at the start of an error message.
+    directory : Path or None
+        The directory a path in the text (``agents_from``) is relative to: the scenario file's;
+        by default the current directory.
 
     Text with the keys of a sweep file (:data:`SWEEP_KEYS`) is refused in one line that says so.
     """
@@ -190,7 +194,7 @@ def loads(text: str, source: str = "<scenario>") -> Scenario:
             f"{source}: is a sweep file (it has {', '.join(sweep_keys)}), not a scenario; run it with tmem sweep"
         )
     try:
-        return from_dict(data)
+        return from_dict(crazyflies.expand(data, directory or Path.cwd()))
     except ScenarioError as exc:
         raise ScenarioError(f"{source}: {exc}") from None
 

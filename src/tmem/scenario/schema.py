@@ -370,7 +370,16 @@ class Scenario(StrictModel):
 
     def _check_agents(self, axes: int) -> None:
         seen: dict[tuple, int] = {}
+        named: dict[str, int] = {}
         for k, agent in enumerate(self.agents):
+            if agent.name is not None:
+                if agent.name in named:
+                    raise FieldError(f"agents[{k}].name", f"{agent.name!r} is the name of agents[{named[agent.name]}]: "
+                                     "names tell the agents' trajectories apart")  # fmt: skip
+                named[agent.name] = k
+                if agent.name.startswith("agent") and agent.name[5:].isdigit() and agent.name != f"agent{k + 1}":
+                    raise FieldError(f"agents[{k}].name", f"{agent.name!r} is the name an unnamed agent "
+                                     f"{agent.name[5:]} gets (agents are numbered from 1); choose another")  # fmt: skip
             place = tuple(np.ravel(agent.position).tolist())
             if place in seen:
                 raise FieldError(

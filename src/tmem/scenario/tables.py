@@ -10,6 +10,7 @@ spans fields raises :class:`FieldError` naming the field at fault.
 
 from __future__ import annotations
 
+import re
 from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
@@ -361,16 +362,27 @@ class SwarmParams(StrictModel):
 
 
 Vector = Number | list[Number]
+#: What an agent's name may hold: a robot's name, as ROS writes them (it names the agent's trajectory).
+AGENT_NAME = re.compile(r"[A-Za-z0-9_.-]{1,64}")
 
 
 class Agent(StrictModel):
-    """Initial state of one agent (Table 2): a number per axis, or one number on one axis."""
+    """Initial state of one agent (Table 2): a number per axis, or one number on one axis; its
+    ``name`` (a robot's, say) names its trajectory in the run's files."""
 
+    name: str | None = None
     position: Vector
     velocity: Vector = 0.0
     tilt: Vector = 0.0
     tilt_rate: Vector = 0.0
     active: bool = True
+
+    @field_validator("name")
+    @classmethod
+    def _a_robot_name(cls, v: str | None) -> str | None:
+        if v is not None and not AGENT_NAME.fullmatch(v):
+            raise ValueError(f"must be 1 to 64 letters, digits, '_', '.' or '-' (a robot's name), got {v!r}")
+        return v
 
 
 class Command(StrictModel):

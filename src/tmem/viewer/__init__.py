@@ -19,7 +19,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..outputs import check_file, replace_file
-from ..saved import RunReadError
+from ..trajectory_file import RunReadError
 from .data import MAX_AGENTS, read_view
 from .page import VIEW_MARK, render
 
@@ -62,7 +62,7 @@ def write_view(run_dir: str | Path, out: str | Path | None = None, max_agents: i
     ------
     ValueError
         In one line: a limit below 1, a directory that is not a readable run
-        (:class:`~tmem.saved.RunReadError`), or an ``out`` that may not be written
+        (:class:`~tmem.trajectory_file.RunReadError`), or an ``out`` that may not be written
         (:class:`tmem.outputs.OutputError`).  Nothing is written then; an
         interrupted write leaves ``out`` as it was.
     """

@@ -7,9 +7,10 @@ state (not yet flying, flying, removed), the formation edges between kept
 agents with their strain ``(|d| - d_t) / d_t`` and flag ``F_en``, and the
 series of the linked panels (RMS velocity, pair distances).
 
-The state variables are named by the run's vehicle model
-(:attr:`tmem.model.base.VehicleModel.state_names`, at its ``POSITION`` and
-``VELOCITY`` indices), built from the scenario the file carries.
+The file is read through :mod:`tmem.trajectory_file`: the positions are its
+coordinates ``x``, ``y``, ``z``, the velocity one variable per axis named by the
+run's vehicle model (:attr:`tmem.model.base.VehicleModel.state_names`, at its
+``VELOCITY`` index; ``V_x``, ``V_y``), built from the scenario the file carries.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..drawing import columns_of, evenly, strain_limit
-from ..saved import RunReadError, reading, run_directory
+from ..trajectory_file import RunReadError, axis_variables, check_layout, reading, run_axes, run_directory
 
 #: Most agents shown; larger runs are thinned evenly to this many.
 MAX_AGENTS = 1000
@@ -35,7 +36,7 @@ MAX_EDGES = 3000
 #: Most pairs drawn one line each in the distance panel; more are drawn as their
 #: smallest, median and largest distance.
 MAX_PAIR_LINES = 60
-#: Most values read from the file at once (a block of frames of a large swarm).
+#: Most values read from the file at once (a block of agents' records of a large swarm).
 _READ_VALUES = 20_000_000
 #: Codes of an agent's state in :attr:`View.status`.
 WAITING, FLYING, REMOVED = 0, 1, 2
@@ -158,18 +159,22 @@ def _scenario_and_model(text, path: Path):
     return scenario, vehicle_model(scenario.model)
 
 
-def _at_frames(values, frames: np.ndarray, columns: np.ndarray | None = None) -> np.ndarray:
-    """``values[frames][:, columns]`` of a variable over (time, ...), read a block of frames at a time
-    so that a large swarm's file is never in memory whole."""
-    if 0 in values.shape:  # no pairs: HDF5 selects nothing from an empty dataset
-        return np.zeros((len(frames), *values.shape[1:]), values.dtype)
-    every = len(frames) == values.shape[0]
-    step = max(1, _READ_VALUES // int(np.prod(values.shape[1:])))
+def _at_frames(values, frames: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+    """A variable over ``(time,)`` or ``(row, time)`` at ``frames``, as ``(frame,)`` or ``(frame, row)``
+    (``rows``: the agents kept; None for every row).  Each row is a record over time in the file, so
+    a block of rows is read at a time, and a large swarm's file is never in memory whole."""
+    if values.ndim == 1:
+        return np.asarray(values[...])[frames]
+    rows = np.arange(values.shape[0]) if rows is None else rows
+    if 0 in values.shape or len(rows) == 0:  # no pairs: HDF5 selects nothing from an empty dataset
+        return np.zeros((len(frames), len(rows)), values.dtype)
+    every = len(rows) == values.shape[0]
+    step = max(1, _READ_VALUES // values.shape[1])
     blocks = []
-    for start in range(0, len(frames), step):
-        block = np.asarray(values[start : start + step] if every else values[frames[start : start + step]])
-        blocks.append(block if columns is None else block[:, columns])
-    return np.concatenate(blocks)
+    for start in range(0, len(rows), step):
+        block = np.asarray(values[start : start + step] if every else values[rows[start : start + step]])
+        blocks.append(block[:, frames])
+    return np.concatenate(blocks).T
 
 
 def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
@@ -177,9 +182,10 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
     import h5netcdf
 
     with h5netcdf.File(path, "r") as f:
+        check_layout(f, path, "view")
         scenario, model = _scenario_and_model(f.attrs.get("scenario"), path)
         variables = f.variables
-        n_times, n_agents, n_axes = variables[model.state_names[model.POSITION]].shape
+        n_axes, (n_agents, n_times) = len(run_axes(f)), variables["active"].shape
         if n_times == 0 or n_agents == 0:
             raise RunReadError(f"view: {path}: the run recorded no times or no agents")
         agents = evenly(n_agents, max_agents, "agents").index
@@ -187,23 +193,26 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
             max_frames = min(MAX_FRAMES, max(2, MAX_COORDINATES // (len(agents) * n_axes)))
         frames = evenly(n_times, max_frames, "frames").index
 
-        def at_frames(name: str, columns: np.ndarray | None = None) -> np.ndarray:
-            return _at_frames(variables[name], frames, columns)
+        def at_frames(name: str, rows: np.ndarray | None = None) -> np.ndarray:
+            return _at_frames(variables[name], frames, rows)
 
-        position = at_frames(model.state_names[model.POSITION], agents).astype(float)
-        speed = np.linalg.norm(at_frames(model.state_names[model.VELOCITY], agents), axis=-1)
+        def per_axis(name: str | None) -> np.ndarray:
+            return np.stack([at_frames(v, agents) for v in axis_variables(f, name)], axis=-1).astype(float)
+
+        position = per_axis(None)
+        speed = np.linalg.norm(per_axis(model.state_names[model.VELOCITY]), axis=-1)
         status = agent_status(at_frames("active", agents).astype(bool))
         ids = np.asarray(variables["agent"][...])
         pairs = np.stack([variables["pair_i"][...], variables["pair_j"][...]], axis=1).astype(int).reshape(-1, 2)
-        distance = at_frames("distance").reshape(len(frames), len(pairs)).astype(float)
+        distance = at_frames("distance").astype(float)
         d_t = np.asarray(variables["d_t"][...], dtype=float)
         edges, edge_pairs = _edges(ids[agents], pairs)
         strain = distance[:, edge_pairs] / d_t[edge_pairs] - 1.0
-        coupled = at_frames("F_en").reshape(len(frames), len(pairs))[:, edge_pairs] == 1
+        coupled = at_frames("F_en")[:, edge_pairs] == 1
         pair_labels, pair_distance = _pair_series(distance, pairs)
         view = View(
             name=scenario.name,
-            axis_names=["x", "y", "z"][:n_axes],
+            axis_names=list(run_axes(f)),
             radius=scenario.interaction.radius,
             reach=scenario.interaction.reach,
             space=_space(scenario),
