@@ -237,6 +237,16 @@ def scales(turbulence: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 @numba.njit(cache=True, inline="always")
+def _normals(seed, agent, step):
+    """The five standard normal draws of an agent's gusts at ``step``: the message ``(seed, agent, WIND_STREAM, step)``."""
+    key = message_key(seed, agent, WIND_STREAM, step)
+    n1, n2 = normal_pair(key, 0)
+    n3, n4 = normal_pair(key, 1)
+    n5, _ = normal_pair(key, 2)
+    return n1, n2, n3, n4, n5
+
+
+@numba.njit(cache=True, inline="always")
 def _filter(g, lag, c, o, n1, n2):
     """One step (D6) of the filter whose numbers start at ``c[o]``: ``(g, lag)`` after it."""
     return (c[o] * g + c[o + 1] * lag + c[o + 4] * n1,
@@ -260,10 +270,7 @@ def next_gusts(z, c, seed, agent, step):
     step : int
         The step drawn (its draws are the message ``(seed, agent, WIND_STREAM, step)``).
     """
-    key = message_key(seed, agent, WIND_STREAM, step)
-    n1, n2 = normal_pair(key, 0)
-    n3, n4 = normal_pair(key, 1)
-    n5, _ = normal_pair(key, 2)
+    n1, n2, n3, n4, n5 = _normals(seed, agent, step)
     u, _ = _filter(z[0], 0.0, c, 0, n1, 0.0)
     v, v_lag = _filter(z[1], z[3], c, PER_COMPONENT, n2, n3)
     w, w_lag = _filter(z[2], z[4], c, 2 * PER_COMPONENT, n4, n5)
@@ -283,10 +290,7 @@ def first_gusts(c, seed, agent):
     agent : int
         The agent's number in the scenario.
     """
-    key = message_key(seed, agent, WIND_STREAM, 0)
-    n1, n2 = normal_pair(key, 0)
-    n3, n4 = normal_pair(key, 1)
-    n5, _ = normal_pair(key, 2)
+    n1, n2, n3, n4, n5 = _normals(seed, agent, 0)
     v, w = PER_COMPONENT + 7, 2 * PER_COMPONENT + 7
     return c[7] * n1, c[v] * n2, c[w] * n4, c[v + 1] * n2 + c[v + 2] * n3, c[w + 1] * n4 + c[w + 2] * n5
 
