@@ -1,0 +1,83 @@
+"""The wind axis of "What survives" in docs/vehicles.md: Fig. 9 and the hex in wind, from the sweeps.
+
+::
+
+    python docs/scripts/survive_wind.py out
+
+reads the ``results.parquet`` of examples/sweeps/vehicles_fig9_wind.toml and vehicles_hex19_wind.toml
+(run with ``tmem sweep FILE --out out/vehicles_NAME``), prints Fig. 9's breaking points (coupling (9)
+off the first pass, no uncoupling after the command), the hex's largest edge error over the last
+20 s beside the 1 m band, and both tables, and draws docs/images/vehicles-wind.png with the linear
+model's and the exact quadrotor's calm values, flown here, as reference lines.  Where the sensing
+sweeps were run under the same ``out``, it checks that their reference case gave the wind sweeps'.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from survive import (  # first: it selects matplotlib's file backend
+    BAND, FIG9_COLUMNS, FIG9_METRICS, HEX_COLUMNS, HEX_METRICS, IMAGES, WIND_AXES, describe_case, draw_panels, fig9_values,
+    hex_values, print_first_pass, print_references, read, references, save, table,
+)
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def print_band(rows) -> None:
+    """The hex's shape: each case's largest edge error over the last 20 s beside the reference's and :data:`BAND`."""
+    metric = "formation.distance_error_last_20s.max"
+    reference = rows[rows["axis"].isna()][metric].iloc[0]
+    kept = rows[rows[metric] <= BAND]
+    print(f"within {BAND} m over the last 20 s: {len(kept)} of {len(rows)} cases; largest edge error over the last 20 s "
+          f"against the reference's {reference:.2f} m: " + ", ".join(f"{describe_case(r)}: {r[metric]:.2f}" for _, r in rows[rows['axis'].notna()].iterrows()))  # fmt: skip
+
+
+def check_reference(out: Path, name: str, rows) -> None:
+    """Say whether the wind sweep's reference case gave the sensing sweep's figures, where both were run."""
+    if not (out / f"vehicles_{name}_sensing" / "results.parquet").exists():
+        return
+    earlier = read(out, f"{name}_sensing")
+    columns = [c for c in FIG9_COLUMNS | HEX_COLUMNS if c in rows]
+    ours, theirs = (r[r["axis"].isna()].iloc[0][columns].astype(float).to_numpy() for r in (rows, earlier))
+    same = np.array_equal(ours, theirs, equal_nan=True)
+    print(f"{name}: the wind sweep's reference case {'gives' if same else 'does NOT give'} the sensing sweep's figures", file=sys.stderr)
+
+
+def wind_report(out: Path, refs: dict) -> None:
+    """The wind sweeps: Fig. 9's and the hex's tables and breaking points, and docs/images/vehicles-wind.png."""
+    pair, hexagon = read(out, "fig9_wind"), read(out, "hex19_wind")
+    print("\n### Fig. 9 in wind\n")
+    print_first_pass(pair)
+    print()
+    table(pair, FIG9_COLUMNS, WIND_AXES)
+    print("\n### hex19 in wind\n")
+    print_band(hexagon)
+    print()
+    table(hexagon, HEX_COLUMNS, WIND_AXES)
+    for name, rows in (("fig9", pair), ("hex19", hexagon)):
+        check_reference(out, name, rows)
+    fig, panels = plt.subplots(len(FIG9_METRICS) + len(HEX_METRICS), len(WIND_AXES), figsize=(9, 2.3 * (len(FIG9_METRICS) + len(HEX_METRICS))), squeeze=False)
+    draw_panels(panels[: len(FIG9_METRICS)], pair, {k[1]: fig9_values(v) for k, v in refs.items() if k[0] == "fig9"},
+                {k: f"Fig. 9: {v}" for k, v in FIG9_METRICS.items()}, WIND_AXES)  # fmt: skip
+    draw_panels(panels[len(FIG9_METRICS) :], hexagon, {k[1]: hex_values(v) for k, v in refs.items() if k[0] == "hex19"},
+                {k: f"hex19: {v}" for k, v in HEX_METRICS.items()}, WIND_AXES, BAND)  # fmt: skip
+    panels[0][0].legend(fontsize=7)
+    save(fig, IMAGES / "vehicles-wind.png")
+
+
+def main(argv: list[str]) -> None:
+    if len(argv) != 1:
+        sys.exit("usage: python docs/scripts/survive_wind.py OUT")
+    started = time.perf_counter()
+    refs = references()
+    print_references(refs)
+    wind_report(Path(argv[0]), refs)
+    print(f"{time.perf_counter() - started:.0f} s", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
