@@ -126,7 +126,7 @@ def print_reruns(names: list[str]) -> None:
             print(f"| {name if k == 0 else ''} | {paper if k == 0 else ''} | {key} | {ours[key]} | {theirs[key]} |", flush=True)
 
 
-#: The swept quantities of the one-at-a-time sweeps: (column, label, scale).
+#: The swept quantities of the one-at-a-time sweeps: (column, label, scale; ``None`` for named levels).
 SENSING_AXES = (
     ("sensing.position_noise", "position noise (m); velocity noise = position / 3 s", "log"),
     ("sensing.delay", "fixed delay (s)", "log"),
@@ -135,7 +135,7 @@ SENSING_AXES = (
 #: The wind sweeps' (vehicles_*_wind.toml): a constant wind along x, and Dryden turbulence by severity.
 WIND_AXES = (
     ("wind along x", "constant wind along x (m/s)", "linear"),
-    ("wind.turbulence.severity", "Dryden turbulence, no mean wind", "linear"),
+    ("wind.turbulence.severity", "Dryden turbulence, no mean wind", None),
 )
 AXES = SENSING_AXES + WIND_AXES
 #: How much later than the reference a coupling may come and still be on the first pass (s).
@@ -240,7 +240,8 @@ def draw_panels(panels, rows, refs: dict, metrics: dict[str, str], axes=SENSING_
                     ax.axhline(refs[name][metric], color="k", ls=style, lw=1, label=name)
             if band is not None and r == 0:
                 ax.axhline(band, color="C3", lw=0.8, alpha=0.5)
-            ax.set_xscale(scale)
+            if scale is not None:  # named levels keep matplotlib's categorical axis
+                ax.set_xscale(scale)
             ax.set_xlabel(axis_label if r == len(metrics) - 1 else "")
             ax.set_ylabel(label if c == 0 else "")
             ax.grid(alpha=0.3)

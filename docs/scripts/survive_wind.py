@@ -7,8 +7,9 @@
 reads the ``results.parquet`` of examples/sweeps/vehicles_fig9_wind.toml and vehicles_hex19_wind.toml
 (run with ``tmem sweep FILE --out out/vehicles_NAME``), prints Fig. 9's breaking points (coupling (9)
 off the first pass, no uncoupling after the command), the hex's largest edge error over the last
-20 s beside the 1 m band, and both tables, and draws docs/images/vehicles-wind.png with the linear
-model's and the exact quadrotor's calm values, flown here, as reference lines.  Where the sensing
+20 s beside the 1 m band, under (11) alone and synchronised, and their tables, and draws
+docs/images/vehicles-wind.png with the linear model's and the exact quadrotor's calm values, flown
+here, as reference lines.  Where the sensing
 sweeps were run under the same ``out``, it checks that their reference case gave the wind sweeps'.
 """
 
@@ -47,6 +48,11 @@ def check_reference(out: Path, name: str, rows) -> None:
     print(f"{name}: the wind sweep's reference case {'gives' if same else 'does NOT give'} the sensing sweep's figures", file=sys.stderr)
 
 
+#: The hex's panels in wind: its shape over the last 20 s and its speed, under (11) alone and synchronised.
+HEX_WIND_METRICS = {k: HEX_METRICS[k] for k in ("formation.distance_error_last_20s.max", "rms_change_percent")}
+MODES = {False: "hex19, (11) alone", True: "hex19, synchronised (S2)"}
+
+
 def wind_report(out: Path, refs: dict) -> None:
     """The wind sweeps: Fig. 9's and the hex's tables and breaking points, and docs/images/vehicles-wind.png."""
     pair, hexagon = read(out, "fig9_wind"), read(out, "hex19_wind")
@@ -54,17 +60,23 @@ def wind_report(out: Path, refs: dict) -> None:
     print_first_pass(pair)
     print()
     table(pair, FIG9_COLUMNS, WIND_AXES)
-    print("\n### hex19 in wind\n")
-    print_band(hexagon)
-    print()
-    table(hexagon, HEX_COLUMNS, WIND_AXES)
-    for name, rows in (("fig9", pair), ("hex19", hexagon)):
-        check_reference(out, name, rows)
-    fig, panels = plt.subplots(len(FIG9_METRICS) + len(HEX_METRICS), len(WIND_AXES), figsize=(9, 2.3 * (len(FIG9_METRICS) + len(HEX_METRICS))), squeeze=False)
+    modes = dict(list(hexagon.groupby("interaction.synchronise")))
+    for synchronised, rows in modes.items():
+        print(f"\n### {MODES[synchronised]} in wind\n")
+        print_band(rows)
+        print()
+        table(rows, HEX_COLUMNS, WIND_AXES)
+    check_reference(out, "fig9", pair)
+    check_reference(out, "hex19", modes[False])
+    n = len(FIG9_METRICS) + len(HEX_WIND_METRICS) * len(modes)
+    fig, panels = plt.subplots(n, len(WIND_AXES), figsize=(9, 2.2 * n), squeeze=False)
     draw_panels(panels[: len(FIG9_METRICS)], pair, {k[1]: fig9_values(v) for k, v in refs.items() if k[0] == "fig9"},
                 {k: f"Fig. 9: {v}" for k, v in FIG9_METRICS.items()}, WIND_AXES)  # fmt: skip
-    draw_panels(panels[len(FIG9_METRICS) :], hexagon, {k[1]: hex_values(v) for k, v in refs.items() if k[0] == "hex19"},
-                {k: f"hex19: {v}" for k, v in HEX_METRICS.items()}, WIND_AXES, BAND)  # fmt: skip
+    for m, (synchronised, rows) in enumerate(modes.items()):
+        first = len(FIG9_METRICS) + m * len(HEX_WIND_METRICS)
+        refs_hex = {k[1]: hex_values(v) for k, v in refs.items() if k[0] == "hex19" and not synchronised}
+        draw_panels(panels[first : first + len(HEX_WIND_METRICS)], rows, refs_hex,
+                    {k: f"{MODES[synchronised]}:\n{v}" for k, v in HEX_WIND_METRICS.items()}, WIND_AXES, BAND)  # fmt: skip
     panels[0][0].legend(fontsize=7)
     save(fig, IMAGES / "vehicles-wind.png")
 
