@@ -1,7 +1,8 @@
-"""The sweeps of "What survives" (docs/vehicles.md): the quadrotor under sensing effects, swept on Dask.
+"""The sweeps of "What survives" (docs/vehicles.md): the quadrotor under sensing effects and wind, swept on Dask.
 
-The sweep files load and build every case; a sensing key sweeps a base that has no ``[sensing]``
-table; a mini sweep of the hex on the quadrotor with delays, run through a Dask cluster, gives the
+The sweep files load and build every case; the wind sweeps start from the sensing sweeps' reference
+and blow the winds their files name; a sensing key sweeps a base that has no ``[sensing]`` table,
+and a wind key one that has no ``[wind]`` table; a mini sweep of the hex on the quadrotor with delays, run through a Dask cluster, gives the
 rows a direct :func:`tmem.simulate` of each case gives; the formation's error over the last 20 s
 agrees with the settling time, a different reading of the same run.
 """
@@ -14,13 +15,14 @@ from dask.distributed import LocalCluster
 import tmem
 from tmem.metrics import LAST_WINDOW, SETTLE_BAND, summarize
 from tmem.scenario import ScenarioError, load, with_changes
-from tmem.sweep import load_sweep, loads_sweep, run_sweep
+from tmem.sweep import SweepError, load_sweep, loads_sweep, run_sweep
 
 ROOT = Path(__file__).parent.parent
 SWEEPS = ROOT / "examples" / "sweeps"
 
 
-@pytest.mark.parametrize(("name", "cases"), [("fig9_sensing", 34), ("hex19_sensing", 34), ("hex19_grid", 60)])
+@pytest.mark.parametrize(("name", "cases"), [("fig9_sensing", 34), ("hex19_sensing", 34), ("hex19_grid", 60),
+                                             ("fig9_wind", 19), ("hex19_wind", 32)])  # fmt: skip
 def test_the_sweep_files_load_on_the_quadrotor_at_100_hz(name, cases):
     sweep = load_sweep(SWEEPS / f"vehicles_{name}.toml")
     assert sweep.n_cases == cases
@@ -28,6 +30,57 @@ def test_the_sweep_files_load_on_the_quadrotor_at_100_hz(name, cases):
     for case in sweep.cases():  # every case is a valid scenario; noise keeps velocity = position / 3 s
         changed = with_changes(sweep.base, case.changes).sensing
         assert changed.velocity_noise == pytest.approx(changed.position_noise / 3.0, abs=1e-4)
+
+
+#: MIL-F-8785C's wind speeds at 20 ft for light, moderate and severe turbulence: 15, 30, 45 knots (m/s).
+W20 = {"light": 15 * 1852 / 3600, "moderate": 30 * 1852 / 3600, "severe": 45 * 1852 / 3600}
+
+
+@pytest.mark.parametrize("vehicle", ["fig9", "hex19"])
+def test_the_wind_sweeps_start_from_the_sensing_sweeps_reference(vehicle):
+    wind, sensing = (load_sweep(SWEEPS / f"vehicles_{vehicle}_{axis}.toml") for axis in ("wind", "sensing"))
+    built = [with_changes(wind.base, case.changes) for case in wind.cases()]
+    assert built[0] == with_changes(sensing.base, sensing.cases()[0].changes) and built[0].wind is None
+    assert all(s.sensing == built[0].sensing for s in built)
+    winds = {synchronised: [s.wind for s in built if s.interaction.synchronise == synchronised and s.wind is not None]
+             for synchronised in (False, True)}  # fmt: skip
+    assert winds[True] == ([] if vehicle == "fig9" else winds[False])  # the hex flies each wind both ways
+    constant = [w.mean() for w in winds[False] if w.turbulence is None]
+    speeds = [1.0, 2.0, 5.0, 8.0, 12.0, 16.0] + ([20.0, 30.0, 40.0] if vehicle == "fig9" else [])
+    assert [x for x, _, _ in constant] == speeds and all(y == z == 0.0 for _, y, z in constant)  # along x
+    gusts = [w for w in winds[False] if w.turbulence is not None]
+    assert all(w.velocity is None and w.vertical == 0.0 for w in gusts)  # turbulence alone, no mean wind
+    assert sorted((w.turbulence.severity, w.turbulence.seed) for w in gusts) == [(k, s) for k in sorted(W20) for s in (1, 2, 3)]
+    for w in gusts:  # the field passes at the intensity's own W_20, to the table's 3 decimals
+        assert w.passing_speed() == pytest.approx(W20[w.turbulence.severity], abs=5e-4)
+
+
+def test_wind_keys_by_path_build_the_table_a_file_spells_out():
+    calm, windy = (load(ROOT / "examples" / "vehicles" / f"{name}.toml") for name in ("hex19", "hex19_wind"))
+    assert calm.wind is None
+    changes = {"wind.velocity": [2.0, 0.0], "wind.vertical": 0.0, "wind.turbulence.severity": "light",
+               "wind.turbulence.height": 10.0, "wind.turbulence.seed": 0, "name": windy.name}  # fmt: skip
+    assert with_changes(calm, changes) == windy
+    assert with_changes(calm, {"wind.turbulence.seed": 4, "wind.velocity": [1.0, 0.0], "wind.turbulence.w20": 3.0}).wind.turbulence.height == 10.0
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"wind.turbulence.sevrity": "light"}, r"^wind\.turbulence\.sevrity: unknown key"),
+    ({"wind.turbulence.severity": "fierce", "wind.turbulence.speed": 5.0}, r"^wind\.turbulence\.severity: must be 'light', 'moderate' or 'severe'"),
+    ({"wind.turbulence.severity": "light"}, r"^wind\.turbulence\.speed: is required when there is no constant wind"),
+    ({"wind.velocity": [1.0, 0.0]}, r"^wind\.velocity: needs 1 value, one per axis"),
+    ({"wind.velocity.0": 1.0}, r"^wind\.velocity\.0: unknown parameter path"),
+    ({"wind.gust": 1.0}, r"^wind\.gust: unknown key"),
+])  # fmt: skip
+def test_a_bad_wind_key_is_refused_naming_it(changes, message):
+    with pytest.raises(ScenarioError, match=message):
+        with_changes(load(ROOT / "examples" / "vehicles" / "fig9.toml"), changes)
+
+
+def test_a_bad_wind_case_stops_the_sweep_before_anything_runs():
+    text = 'base = "../examples/vehicles/fig9.toml"\ncase = [{}, { "wind.turbulence.severity" = "light", "wind.turbulence.seed" = 1 }]\n'
+    with pytest.raises(SweepError, match=r"wind\.turbulence\.speed: is required"):
+        loads_sweep(text, source="wind.toml", directory=Path(__file__).parent)
 
 
 def test_a_sensing_key_adds_the_table_to_a_base_without_one():

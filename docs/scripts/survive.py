@@ -7,10 +7,11 @@ Two parts::
 
 ``reruns`` flies the paper's Figs. 5, 7 and 9, the formation flights of docs/swarms.md and the gas
 of examples/swarm/gas2d.toml on the linear model (2) and on the quadrotor, and prints one Markdown
-table.  ``sweeps`` reads the ``results.parquet`` of the three sweeps of examples/sweeps/vehicles_*.toml
-(run with ``tmem sweep FILE --out out/vehicles_NAME``), prints their tables and draws
-docs/images/vehicles-*.png, with the linear model's and the exact quadrotor's values, flown here,
-as reference lines.  The total runtime goes to standard error.
+table.  ``sweeps`` reads the ``results.parquet`` of the three sensing sweeps of
+examples/sweeps/vehicles_*.toml (run with ``tmem sweep FILE --out out/vehicles_NAME``), prints their
+tables and draws docs/images/vehicles-*.png, with the linear model's and the exact quadrotor's
+values, flown here, as reference lines.  docs/scripts/survive_wind.py does the same for the two wind
+sweeps, with this module's tables and panels.  The total runtime goes to standard error.
 """
 
 from __future__ import annotations
@@ -19,11 +20,15 @@ import sys
 import time
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 
-import tmem
-from tmem.metrics import summarize
-from tmem.scenario import Scenario, from_dict, load, with_changes
+matplotlib.use("Agg")  # files only
+import matplotlib.pyplot as plt  # noqa: E402
+
+import tmem  # noqa: E402
+from tmem.metrics import summarize  # noqa: E402
+from tmem.scenario import Scenario, from_dict, load, with_changes  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 EXAMPLES = ROOT / "examples"
@@ -121,12 +126,18 @@ def print_reruns(names: list[str]) -> None:
             print(f"| {name if k == 0 else ''} | {paper if k == 0 else ''} | {key} | {ours[key]} | {theirs[key]} |", flush=True)
 
 
-#: The swept quantities of the one-at-a-time sweeps: (column, label, scale); a wind axis is one more row.
-AXES = (
+#: The swept quantities of the one-at-a-time sweeps: (column, label, scale; ``None`` for named levels).
+SENSING_AXES = (
     ("sensing.position_noise", "position noise (m); velocity noise = position / 3 s", "log"),
     ("sensing.delay", "fixed delay (s)", "log"),
     ("sensing.loss", "message loss (probability)", "linear"),
 )
+#: The wind sweeps' (vehicles_*_wind.toml): a constant wind along x, and Dryden turbulence by severity.
+WIND_AXES = (
+    ("wind along x", "constant wind along x (m/s)", "linear"),
+    ("wind.turbulence.severity", "Dryden turbulence, no mean wind", None),
+)
+AXES = SENSING_AXES + WIND_AXES
 #: How much later than the reference a coupling may come and still be on the first pass (s).
 FIRST_PASS = 0.5
 #: The band a formation must keep its edges within, once formed (m).
@@ -142,12 +153,19 @@ def axis_of(row) -> str | None:
 
 
 def read(out: Path, name: str):
-    """The rows of ``out/vehicles_NAME/results.parquet``, each with the axis it varies."""
+    """The rows of ``out/vehicles_NAME/results.parquet``, each with the axis it varies.
+
+    A constant wind's JSON ``wind.velocity`` becomes its x part, the column ``wind along x``.
+    """
+    import json
+
     import pandas as pd
 
     rows = pd.read_parquet(out / f"vehicles_{name}" / "results.parquet")
     if rows["error"].notna().any():
         print(f"{name}: {rows['error'].notna().sum()} cases failed: {rows['error'].dropna().unique()}", file=sys.stderr)
+    if "wind.velocity" in rows:
+        rows["wind along x"] = [json.loads(v)[0] if isinstance(v, str) else np.nan for v in rows["wind.velocity"]]
     rows["axis"] = [axis_of(r) for _, r in rows.iterrows()]
     return rows
 
@@ -186,29 +204,27 @@ def _spread(values) -> str:
     return f"{np.mean(values):.2f} [{min(values):.2f}, {max(values):.2f}]"
 
 
-def table(rows, columns: dict[str, str]) -> None:
-    """One Markdown row per level of each axis: each column's mean [least, largest] over the seeds."""
+def _level(value) -> str:
+    return value if isinstance(value, str) else f"{value:g}"
+
+
+def table(rows, columns: dict[str, str], axes=SENSING_AXES) -> None:
+    """One Markdown row per level of each of ``axes``: each column's mean [least, largest] over the seeds."""
     print("| swept | level | " + " | ".join(columns.values()) + " |")
     print("| --- | --- | " + " | ".join("---" for _ in columns) + " |")
     print("| reference (100 Hz) | | " + " | ".join(_spread(rows[rows["axis"].isna()][c]) for c in columns) + " |")
-    for column, label, _ in AXES:
+    for column, label, _ in axes:
         for level, group in rows[rows["axis"] == column].groupby(column):
             missing = {c: int(group[c].isna().sum()) for c in columns}
             cells = [_spread(group[c]) + (f" ({missing[c]} of {len(group)} never)" if missing[c] else "") for c in columns]
-            print(f"| {label.split(';')[0]} | {level:g} | " + " | ".join(cells) + " |")
+            print(f"| {label.split(';')[0]} | {_level(level)} | " + " | ".join(cells) + " |")
 
 
-def draw_axes(rows, refs: dict, metrics: dict[str, str], path: Path, band: float | None = None) -> None:
-    """A grid of panels: a row per metric, a column per swept quantity, with the reference lines."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def draw_panels(panels, rows, refs: dict, metrics: dict[str, str], axes=SENSING_AXES, band: float | None = None) -> None:
+    """Into ``panels``, a row per metric and a column per swept quantity: the cases, their means and the reference lines."""
     reference = rows[rows["axis"].isna()].iloc[0]
-    fig, panels = plt.subplots(len(metrics), len(AXES), figsize=(4.2 * len(AXES), 2.6 * len(metrics)), squeeze=False)
     for r, (metric, label) in enumerate(metrics.items()):
-        for c, (column, axis_label, scale) in enumerate(AXES):
+        for c, (column, axis_label, scale) in enumerate(axes):
             ax = panels[r][c]
             cases = rows[rows["axis"] == column]
             ax.plot(cases[column], cases[metric], "o", ms=3, color="C0", alpha=0.6)
@@ -218,21 +234,33 @@ def draw_axes(rows, refs: dict, metrics: dict[str, str], path: Path, band: float
             if len(never):
                 top = np.nanmax(rows[metric]) if rows[metric].notna().any() else 1.0
                 ax.plot(never[column], np.full(len(never), top), "x", color="C3", label="never")
-            ax.axhline(reference[metric], color="0.4", lw=1, label="quadrotor, 100 Hz, no noise")
+            ax.axhline(reference[metric], color="0.4", lw=1, label="quadrotor, 100 Hz, nothing else (the reference)")
             for (style, name) in (("--", "linear (2)"), (":", "quadrotor, exact")):
                 if refs.get(name, {}).get(metric) is not None:
                     ax.axhline(refs[name][metric], color="k", ls=style, lw=1, label=name)
             if band is not None and r == 0:
                 ax.axhline(band, color="C3", lw=0.8, alpha=0.5)
-            ax.set_xscale(scale)
+            if scale is not None:  # named levels keep matplotlib's categorical axis
+                ax.set_xscale(scale)
             ax.set_xlabel(axis_label if r == len(metrics) - 1 else "")
             ax.set_ylabel(label if c == 0 else "")
             ax.grid(alpha=0.3)
-    panels[0][0].legend(fontsize=7)
+
+
+def save(fig, path: Path) -> None:
+    """Write ``fig`` to ``path`` and close it."""
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     print(f"wrote {path.relative_to(ROOT)}", file=sys.stderr)
+
+
+def draw_axes(rows, refs: dict, metrics: dict[str, str], path: Path, band: float | None = None) -> None:
+    """A grid of panels: a row per metric, a column per swept quantity of the sensing sweeps."""
+    fig, panels = plt.subplots(len(metrics), len(SENSING_AXES), figsize=(4.2 * len(SENSING_AXES), 2.6 * len(metrics)), squeeze=False)
+    draw_panels(panels, rows, refs, metrics, SENSING_AXES, band)
+    panels[0][0].legend(fontsize=7)
+    save(fig, path)
 
 
 FIG9_METRICS = {"rms_change_percent": "RMS change (%)", "couple_time": "couples at (s)", "uncouple_time": "uncouples at (s)"}
@@ -244,38 +272,50 @@ HEX_METRICS = {
 }
 
 
-def fig9_report(out: Path, refs: dict) -> None:
-    rows = read(out, "fig9_sensing")
+#: The columns of the tables of Fig. 9 and of the hex.
+FIG9_COLUMNS = {"couple_time": "couples at (s)", "uncouple_time": "uncouples at (s)", "pairs.0.separated_at": "apart at (s)",
+                "rms_change_percent": "RMS change (%)", "min_distance": "smallest distance (m)"}  # fmt: skip
+HEX_COLUMNS = {"formation.distance_error_last_20s.max": "largest edge error, last 20 s (m)",
+               "formation.distance_error_last_20s.rms": "RMS edge error, last 20 s (m)",
+               "formation.distance_error.max": "largest edge error, 60 s (m)",
+               "rms_change_percent": "RMS change (%)", "min_distance": "smallest distance (m)"}  # fmt: skip
+
+
+def describe_case(row) -> str:
+    """``axis = level (seed s)``: which case of a one-at-a-time sweep a row is."""
+    seeds = [row[c] for c in ("sensing.seed", "wind.turbulence.seed") if c in row and row[c] == row[c] and row[c] is not None]
+    return f"{row.axis} = {_level(row[row.axis])}" + (f" (seed {seeds[0]:g})" if seeds else "")
+
+
+def print_first_pass(rows) -> None:
+    """Fig. 9's breaking points: the cases whose coupling (9) is off the reference's first pass, and those
+    that coupled and did not uncouple after the command."""
     reference = rows[rows["axis"].isna()].iloc[0]
     off = rows["couple_time"].isna() | ((rows["couple_time"] - reference["couple_time"]).abs() > FIRST_PASS)
-    print(f"\n### Fig. 9\n\ncoupled within {FIRST_PASS} s of the reference's {reference['couple_time']:.2f} s "
-          f"except in {int(off.sum())} of {len(rows)} cases: "
-          + ", ".join(f"{r.axis} = {r[r.axis]:g} (seed {r['sensing.seed']:g}): {_f(r.couple_time)}" for _, r in rows[off].iterrows()))  # fmt: skip
+    print(f"coupled within {FIRST_PASS} s of the reference's {reference['couple_time']:.2f} s "
+          f"except in {int(off.sum())} of {len(rows)} cases: " + ", ".join(f"{describe_case(r)}: {_f(r.couple_time)}" for _, r in rows[off].iterrows()))  # fmt: skip
     failed = rows[rows["coupled"].fillna(False).astype(bool) & rows["uncouple_time"].isna()]
-    print(f"coupled but not uncoupled by the end: {len(failed)} cases " + ", ".join(f"{r.axis}={r[r.axis]:g}" for _, r in failed.iterrows()))
+    print(f"coupled but not uncoupled by the end: {len(failed)} cases " + ", ".join(describe_case(r) for _, r in failed.iterrows()))
+
+
+def fig9_report(out: Path, refs: dict) -> None:
+    rows = read(out, "fig9_sensing")
+    print("\n### Fig. 9\n")
+    print_first_pass(rows)
     print()
-    table(rows, {"couple_time": "couples at (s)", "uncouple_time": "uncouples at (s)", "pairs.0.separated_at": "apart at (s)",
-                 "rms_change_percent": "RMS change (%)", "min_distance": "smallest distance (m)"})  # fmt: skip
+    table(rows, FIG9_COLUMNS)
     draw_axes(rows, {k[1]: fig9_values(v) for k, v in refs.items() if k[0] == "fig9"}, FIG9_METRICS, IMAGES / "vehicles-fig9-sensing.png")
 
 
 def hex_report(out: Path, refs: dict) -> None:
     rows = read(out, "hex19_sensing")
     print("\n### hex19\n")
-    table(rows, {"formation.distance_error_last_20s.max": "largest edge error, last 20 s (m)",
-                 "formation.distance_error_last_20s.rms": "RMS edge error, last 20 s (m)",
-                 "formation.distance_error.max": "largest edge error, 60 s (m)",
-                 "rms_change_percent": "RMS change (%)", "min_distance": "smallest distance (m)"})  # fmt: skip
+    table(rows, HEX_COLUMNS)
     draw_axes(rows, {k[1]: hex_values(v) for k, v in refs.items() if k[0] == "hex19"}, HEX_METRICS, IMAGES / "vehicles-hex19-sensing.png", BAND)
 
 
 def grid_report(out: Path) -> None:
     """The delay x noise grid: the largest edge error over the last 20 s, and where it keeps the band."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     rows = read(out, "hex19_grid")
     metric = "formation.distance_error_last_20s.max"
     fig, panels = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")

@@ -54,7 +54,7 @@ def hover() -> None:
     """One Crazyflie alone (``U = 0``) starting at rest and level in a constant wind along x, 60 s."""
     print("| wind (m/s) | speed at 1 s (m/s) | at 60 s (m/s) | drift from 10 to 60 s (m/s²) | tilt (deg) |")
     print("| --- | --- | --- | --- | --- |")
-    for w in (1.0, 3.0, 5.0):
+    for w in (1.0, 3.0, 5.0, 12.0, 16.0):
         model = QuadrotorModel(QuadrotorModelParams(kind="quadrotor"), WindParams(velocity=[w, 0.0]))
         x = np.zeros((1, 2, 4))
         body, params, u = model.initial_body(x), model.step_params(0.01), np.zeros((1, 2))

@@ -12,11 +12,12 @@ import json
 import math
 import stat
 import tomllib
+import typing
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from . import crazyflies
 from .schema import Scenario
@@ -199,13 +200,21 @@ def loads(text: str, source: str = "<scenario>", directory: Path | None = None) 
         raise ScenarioError(f"{source}: {exc}") from None
 
 
+def _optional_table(table: type[BaseModel] | None, key: str) -> type[BaseModel] | None:
+    """The table (a model) that key ``key`` of ``table`` holds, if it is one; ``None`` past a list."""
+    field = table.model_fields.get(key) if table is not None and isinstance(key, str) else None
+    kinds = typing.get_args(field.annotation) if field is not None else ()
+    return next((k for k in kinds if isinstance(k, type) and issubclass(k, BaseModel)), None)
+
+
 def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
     """A copy of ``scenario`` with values replaced by dotted path, validated again.
 
     Example: ``with_changes(s, {"interaction.function": "repulsion", "agents[1].velocity": 2.0})``.
     A whole list can be replaced too: ``{"agents": [{"position": 0.0}, {"position": 50.0}]}``.
     A key of an optional table the scenario leaves out (``sensing.delay`` without a ``[sensing]``
-    table) adds the table, with its defaults for the keys not given.
+    table, ``wind.turbulence.severity`` without a ``[wind]`` table) adds the table, and any optional
+    table on the path, with their defaults for the keys not given.
 
     Parameters
     ----------
@@ -220,12 +229,14 @@ def with_changes(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
         parts = [int(p) if p.isdigit() else p for p in path.replace("[", ".").replace("]", "").split(".")]
         node = data
         try:
-            if len(parts) > 1 and data[parts[0]] is None:
-                data[parts[0]] = {}
-                added.add(parts[0])
-            for part in parts[:-1]:
+            table: type[BaseModel] | None = Scenario
+            for depth, part in enumerate(parts[:-1]):
+                table = _optional_table(table, part)
+                if isinstance(node, dict) and node.get(part, 0) is None and table is not None:
+                    node[part] = table.model_construct().model_dump()  # its defaults
+                    added.add(tuple(parts[: depth + 1]))
                 node = node[part]
-            if isinstance(node, dict) and parts[-1] not in node and not (len(parts) == 2 and parts[0] in added):
+            if isinstance(node, dict) and parts[-1] not in node and tuple(parts[:-1]) not in added:
                 raise KeyError(parts[-1])
             node[parts[-1]] = value
         except (KeyError, IndexError, TypeError):
