@@ -31,7 +31,7 @@ import numpy as np
 
 from . import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
 from .control import corrected_position, gains_for, tilt_scale
-from .engine.driver import law_of
+from .engine.law import law_of
 from .engine.pairs import formation_pair
 from .engine.records import Agents, Counters, Events, Pairs
 from .model import vehicle_model

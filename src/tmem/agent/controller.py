@@ -28,7 +28,8 @@ from numbers import Real
 
 import numpy as np
 
-from ..engine.driver import law_record, read_events
+from ..engine.driver import read_events
+from ..engine.law import law_record
 from ..engine.records import COMMANDS, Events
 from ..engine.stages import command_pair
 from ..engine.trajectory import Event

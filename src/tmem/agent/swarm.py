@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..control import gains_for
-from ..engine.driver import law_of, record_steps, slot_order
+from ..engine.driver import record_steps, slot_order
+from ..engine.law import law_of
 from ..engine.trajectory import Event
 from ..initial import build
 from ..model import vehicle_model
@@ -72,7 +73,7 @@ def controllers_for(scenario: Scenario) -> list[AgentController]:
     """One controller per agent of ``scenario``, in the order of its agents.
 
     Each has the scenario's gains (:func:`tmem.control.gains_for` on the vehicle model) and law
-    (:func:`tmem.engine.driver.law_of`), its agent's formation edges, the scenario's couple and
+    (:func:`tmem.engine.law.law_of`), its agent's formation edges, the scenario's couple and
     uncouple commands that name one of them (or every pair), and the engine's order of the
     neighbours' pushes (:func:`tmem.engine.driver.slot_order`).
 
