@@ -141,14 +141,14 @@ def test_every_agent_gone_gives_null_not_inf_or_nan():
 def test_table_marks_an_rms_change_taken_while_coupled():
     from rich.console import Console
 
-    from tmem.cli import SWINGS, _summary_table
+    from tmem.terminal import SWINGS, summary_table
 
     rows = {}
     for name, (distance, flag, events, start, _) in COUPLING.items():
         tr = made(distance, flag, events, velocities=np.array([[-1.5, 3.0]] * len(distance)))
         rows[name] = summarize(started_coupled(tr) if start else tr)
     console = Console(width=300, record=True)
-    console.print(_summary_table(rows))
+    console.print(summary_table(rows))
     text = console.export_text()
     lines = {name: next(line for line in text.splitlines() if name in line) for name in rows}
     assert "│ no " in lines["never"] and "yes, 1/1 at end" in lines["formation pair, coupled throughout"]
@@ -184,7 +184,8 @@ def test_the_table2_pair_left_coupled_is_flagged_in_summary_and_table(tmp_path):
 
     from typer.testing import CliRunner
 
-    from tmem.cli import SWINGS, app
+    from tmem.cli import app
+    from tmem.terminal import SWINGS
 
     text = tmem.preset("fig9").to_toml().split("[[commands]]")[0]
     text = text.replace("duration = 60.0", "duration = 6.0").replace("dt = 0.0001", "dt = 0.001")

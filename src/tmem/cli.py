@@ -20,8 +20,8 @@ from typer.core import TyperGroup
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-from rich.table import Column, Table
-from rich.text import Text
+
+from .terminal import LazyProgress, summary_table
 
 
 
@@ -67,36 +67,6 @@ def _options(
 ) -> None:
     """Run a scenario, reproduce the paper, animate or plot a run, sweep many."""
 
-#: Runs expected to take less than this (s) show no progress bar.
-PROGRESS_AFTER = 1.0
-
-
-class _LazyProgress:
-    """A progress bar that appears only once a run has taken ``PROGRESS_AFTER`` seconds."""
-
-    def __init__(self) -> None:
-        self.started = time.perf_counter()
-        self.bar: Progress | None = None
-        self.tasks: dict[str, int] = {}
-
-    def __call__(self, label: str, done: int, total: int) -> None:
-        if self.bar is None:
-            if time.perf_counter() - self.started < PROGRESS_AFTER or not console.is_terminal:
-                return
-            self.bar = Progress(
-                TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
-                TimeRemainingColumn(), console=console, transient=True,
-            )  # fmt: skip
-            self.bar.start()
-        if label not in self.tasks:
-            self.tasks[label] = self.bar.add_task(label, total=total)
-        self.bar.update(self.tasks[label], completed=done)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
-
-
 def _fail(message: str) -> None:
     console.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     raise typer.Exit(2)
@@ -105,37 +75,6 @@ def _fail(message: str) -> None:
 def _say(text: str) -> None:
     """Print ``text`` to standard output as it is: no markup, no highlighting, no wrapping (a path stays whole)."""
     Console().print(text, markup=False, highlight=False, soft_wrap=True)
-
-
-def _number(value: float | None, form: str) -> str:
-    return "—" if value is None else form.format(value)
-
-
-#: Under the table when a run ended with pairs coupled.
-SWINGS = "* pairs still coupled at the end: ΔRMS is an instantaneous value that swings with their oscillation"
-
-
-def _coupled_cell(s: dict) -> str:
-    """``no``, or ``yes`` with how many of the pairs were coupled at the end (a formation starts coupled)."""
-    if not s["coupled"]:
-        return "no"
-    return f"yes, {s['pairs_coupled_at_end']}/{len(s['pairs'])} at end"
-
-
-def _summary_table(rows: dict[str, dict]) -> Table:
-    """The runs' headline figures, one row each; ΔRMS marked ``*`` where pairs were still coupled at the end."""
-    headers = ("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
-    table = Table(*(Column(h, overflow="fold") for h in headers))  # whole names, folded, not cut with "…"
-    for name, s in rows.items():
-        swings = s["rms_change_while_coupled"] and s["rms_change_percent"] is not None
-        table.add_row(
-            Text(name), s["function"], _coupled_cell(s), _number(s["couple_time"], "{:.2f}"),
-            _number(s["uncouple_time"], "{:.2f}"), _number(s["rms_change_percent"], "{:+.3f}") + (" *" if swings else ""),
-            _number(s["min_distance"], "{:.2f}"),
-        )  # fmt: skip
-        if swings:
-            table.caption, table.caption_justify = SWINGS, "left"
-    return table
 
 
 def _resuming(time: float) -> None:
@@ -170,7 +109,7 @@ def run(
     from .io import OutputError, check_output_directory, write_run
     from .scenario import ScenarioError, load
 
-    progress = _LazyProgress()
+    progress = LazyProgress(console)
     checkpoints = None
     try:
         loaded = load(scenario)
@@ -192,7 +131,7 @@ def run(
         said = f"interrupted; no output was written; the same command goes on from t = {checkpoints.saved_time:g} s"
         console.print(said, highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
-    Console().print(_summary_table({loaded.name or scenario.stem: summary}))
+    Console().print(summary_table({loaded.name or scenario.stem: summary}))
     _say(f"written to {out}/")
 
 
@@ -214,14 +153,14 @@ def paper(
     from .io import OutputError
     from .paper import run_paper
 
-    progress = _LazyProgress()
+    progress = LazyProgress(console)
     try:
         summaries, _ = run_paper(out, progress=progress)
     except (OutputError, SimulationError) as exc:
         progress.close()
         _fail(str(exc))
     progress.close()
-    Console().print(_summary_table(summaries))
+    Console().print(summary_table(summaries))
     _say(f"report: {out / 'report.md'}")
 
 
