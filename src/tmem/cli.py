@@ -12,7 +12,6 @@ once.
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 import typer

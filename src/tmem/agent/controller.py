@@ -34,7 +34,6 @@ from ..engine.records import COMMANDS, Events
 from ..engine.stages import command_pair
 from ..engine.trajectory import Event
 from ..interaction.kernels import FunctionParams
-from ..interaction.registry import uses_coupling
 from .kernel import PAIR_FLOATS, PAIR_INTS, control, events_from, law_tables, message_vectors, pairs_from
 from .messages import AgentMessage
 from .settings import DEFAULTS, ControllerError, ControllerSettings, Edge, OperatorCommand

@@ -35,7 +35,7 @@ from .stages import CHUNK
 from .gas import SNAPSHOT, TOTALS, gas_record, wall_params
 from .law import law_of
 from .records import (
-    COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Gas, Neighbours, Pairs, Records, Run,
+    COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
 from .trajectory import DIVERGED, Event, SimulationError, Trajectory
 
