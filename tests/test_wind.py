@@ -197,6 +197,10 @@ WIND_CASES = {
                        "wind.turbulence.sigma[1]", "greater than or equal to 0"),
     "no speed": (QUADROTOR + '\n[wind]\n[wind.turbulence]\nseverity = "light"\n', "wind.turbulence.speed",
                  "is required when there is no constant wind"),
+    "a wind in km/h": (QUADROTOR + "\n[wind]\nvelocity = [1e6]\n", "wind.velocity", "1e+06 m/s, more than 100 m/s"),
+    "an updraught in km/h": (QUADROTOR + "\n[wind]\nvertical = 150.0\n", "wind.vertical", "150 m/s, more than 100"),
+    "gusts in km/h": (QUADROTOR + "\n[wind]\nvelocity = [1.0]\n[wind.turbulence]\nw20 = 120.0\n",
+                      "wind.turbulence.w20", "120 m/s is more than 100 m/s"),
 }
 
 

@@ -32,7 +32,9 @@ if TYPE_CHECKING:
 
 #: The low-altitude model's range of heights, 10 to 1000 ft (m).
 LOWEST, HIGHEST = 3.048, 304.8
-
+#: The strongest wind a scenario may set (m/s): beyond any a multirotor flies in, and above the strongest
+#: surface gust measured (113 m/s, Barrow Island, 1996).  A larger figure is a slip of units.
+STRONGEST = 100.0
 
 
 class TurbulenceParams(StrictModel):
@@ -90,6 +92,17 @@ def check_wind(scenario: Scenario) -> None:
                          "model (2) has no drag: set [model] kind = 'quadrotor' or remove [wind]")  # fmt: skip
     if wind.velocity is not None and len(wind.velocity) != axes:
         raise FieldError("wind.velocity", per_axis(axes, len(wind.velocity)))
+    speed = math.hypot(*wind.mean())
+    if speed > STRONGEST:
+        field = "wind.velocity" if wind.velocity is not None and math.hypot(*wind.velocity) > 0.0 else "wind.vertical"
+        raise FieldError(field, f"the wind's speed is {speed:g} m/s, more than {STRONGEST:g} m/s (stronger than any "
+                         "surface wind measured; check the units: m/s)")  # fmt: skip
+    gusts = wind.turbulence
+    if gusts is not None:
+        for key in ("w20", "speed"):
+            if (getattr(gusts, key) or 0.0) > STRONGEST:
+                raise FieldError(f"wind.turbulence.{key}", f"{getattr(gusts, key):g} m/s is more than {STRONGEST:g} m/s "
+                                 "(stronger than any surface wind measured; check the units: m/s)")  # fmt: skip
     if wind.turbulence is not None and not wind.passing_speed() > 0.0:
         raise FieldError("wind.turbulence.speed", "is required when there is no constant wind: the Dryden form needs "
                          "the speed at which the gusts' frozen field passes the vehicles (m/s)")  # fmt: skip
