@@ -32,12 +32,13 @@ from ..sensing import exact, sensing_of
 from .checkpoint import Checkpoints, Saved, restore
 from .loop import advance_for
 from .stages import CHUNK
-from .gas import SNAPSHOT, TOTALS, gas_record, wall_params
+from .gas import SNAPSHOT, TOTALS, gas_record
 from .law import law_of
 from .records import (
     COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
 from .trajectory import DIVERGED, Event, SimulationError, Trajectory
+from .walls import wall_params
 
 #: Swarms at least this large step on threads: below, starting the threads at every step costs more
 #: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal

@@ -17,11 +17,8 @@ The derivations are in ``docs/gas.md``; equation labels below refer to it.
   energy and its neighbours' within reach, each ``|V|^2`` plus the energy its pushes hold,
   ``(g |U| / omega)^2`` with ``omega`` its slow mode's frequency (T2).  It tilts along its velocity
   so that ``dV/dt = (T* / T_i - 1) V / (2 tau)``: Berendsen's weak coupling, applied per agent.
-* **Walls and obstacles (W1)-(W2).**  A wall or an obstacle is a neighbour held still: the
-  repulsion (8) acts on the distance from the agent's ``P*`` (6) to its nearest point, with
-  ``R + R_w`` for ``R + R_j``.  Held still, it is the case the modal gains were designed for.  A
-  wall has the last word (W2): within its reach, the part of the agent's other pushes that points
-  into it is dropped, and the others get what the tilt limit leaves after the walls' pushes.
+* **Walls and obstacles (W1)-(W2)** are neighbours held still, with the last word on the
+  set-point: :mod:`tmem.engine.walls`.
 
 The running totals (per agent, summed at each record) are those of :data:`TOTALS`.
 """
@@ -32,10 +29,10 @@ import numba
 import numpy as np
 
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..interaction.kernels import FunctionParams, repulsion
 from ..scenario import ThermostatParams
 from ..space import nearest_image
 from .records import Gas
+from .walls import keep_off, wall_pushes, with_priority
 
 #: Long name and units of each column of a record, per unit agent mass: first the running totals
 #: of every agent since the start (:data:`TOTALS`), then what a record adds (:data:`SNAPSHOT`).
@@ -140,118 +137,6 @@ def add_contact(i, j, pressing, virial, work):
 
 
 @numba.njit(cache=True, inline="always")
-def _obstacle_gap(i, o, corrected, obstacles, box, n_axes):
-    """Distance from agent ``i``'s ``P*`` to the centre of obstacle ``o``, and to its surface (m)."""
-    r2 = 0.0
-    for a in range(n_axes):
-        delta = nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a])
-        r2 += delta * delta
-    centre = np.sqrt(r2)
-    return centre, centre - obstacles[o, n_axes]
-
-
-@numba.njit(cache=True, inline="always")
-def _wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes):
-    """The pushes (8) of the walls and obstacles within reach of agent ``i``'s ``P*`` (W1), summed into
-    ``pushed[i]``.  Return how many pushed; the sum of their squared sizes over ``c_max^2`` (C1); the
-    size of the box walls' pushes (rad) and their sum weighted by the agent's distance ``P`` from
-    each wall (rad m); and the obstacles' virial ``(P - c) . u`` about the box's centre ``c``."""
-    contacts = 0
-    pressing = 0.0
-    on_walls = 0.0
-    moment = 0.0
-    obstacle_virial = 0.0
-    reach = wall_params.reach
-    for a in range(n_axes):
-        pushed[i, a] = 0.0
-        if walls[a] > 0.0:
-            low = corrected[i, a, 0]
-            high = walls[a] - low
-            if low < reach:  # the wall at 0 lies at d = -low: its push points along +a
-                u = repulsion(max(low, 0.0), 0, wall_params)
-                pushed[i, a] -= u
-                on_walls -= u
-                moment -= u * corrected[i, a, 1]
-                contacts += 1
-                pressing += (u / wall_params.c_max) ** 2
-            if high < reach:
-                u = repulsion(max(high, 0.0), 0, wall_params)
-                pushed[i, a] += u
-                on_walls -= u
-                moment -= u * (walls[a] - corrected[i, a, 1])
-                contacts += 1
-                pressing += (u / wall_params.c_max) ** 2
-    for o in range(obstacles.shape[0]):
-        centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
-        if gap < reach and centre > 0.0:
-            u = repulsion(max(gap, 0.0), 0, wall_params)
-            for a in range(n_axes):
-                along = u * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
-                pushed[i, a] += along
-                obstacle_virial += (corrected[i, a, 1] - 0.5 * walls[a]) * along
-            contacts += 1
-            pressing += (u / wall_params.c_max) ** 2
-    return contacts, pressing, on_walls, moment, obstacle_virial
-
-
-@numba.njit(cache=True, inline="always")
-def _keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes):
-    """Drop from agent ``i``'s other pushes the part that points into a wall or an obstacle within
-    reach of its ``P*`` (W2): neighbours, formation pulls and the thermostat never push it through.
-    The wall or obstacle takes what is dropped: return its size on the box's walls (rad), its sum
-    weighted by the agent's distance ``P`` from each wall (rad m), as :func:`_wall_pushes` does, and
-    the virial ``(P - c) . u`` of what the obstacles took."""
-    held = 0.0
-    moment = 0.0
-    obstacle_virial = 0.0
-    for a in range(n_axes):
-        if walls[a] > 0.0:
-            if corrected[i, a, 0] < reach and setpoint[i, a] < 0.0:
-                held -= setpoint[i, a]
-                moment -= setpoint[i, a] * corrected[i, a, 1]
-                setpoint[i, a] = 0.0
-            if walls[a] - corrected[i, a, 0] < reach and setpoint[i, a] > 0.0:
-                held += setpoint[i, a]
-                moment += setpoint[i, a] * (walls[a] - corrected[i, a, 1])
-                setpoint[i, a] = 0.0
-    for o in range(obstacles.shape[0]):
-        centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
-        if gap < reach and centre > 0.0:
-            inward = 0.0  # the component along the unit vector from P* to the obstacle's centre
-            for a in range(n_axes):
-                inward += setpoint[i, a] * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
-            if inward > 0.0:
-                for a in range(n_axes):
-                    dropped = inward * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
-                    setpoint[i, a] -= dropped
-                    obstacle_virial -= (corrected[i, a, 1] - 0.5 * walls[a]) * dropped
-    return held, moment, obstacle_virial
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _with_priority(i, setpoint, pushed, c_max, n_axes):
-    """Agent ``i``'s set-point as the walls' pushes plus ``alpha`` times the others, ``alpha`` the
-    largest in ``[0, 1]`` that keeps it within the tilt limit (W2).  Each wall's push is saturated
-    on its own, and walls do not share the limit: in a corner the tilt may reach the larger of
-    ``c_max`` and the walls' pushes together (at most ``sqrt(axes) c_max`` in a box's corner), so
-    that each wall stops the agent as it would alone.  Return ``alpha`` and the limit."""
-    ww = 0.0
-    wr = 0.0
-    rr = 0.0
-    for a in range(n_axes):
-        ww += pushed[i, a] * pushed[i, a]
-        wr += pushed[i, a] * setpoint[i, a]
-        rr += setpoint[i, a] * setpoint[i, a]
-    limit2 = max(c_max * c_max, ww)
-    alpha = 1.0
-    if ww + 2.0 * wr + rr > limit2:  # |w + alpha r| = limit at the root in [0, 1]
-        alpha = (-wr + np.sqrt(max(wr * wr - rr * (ww - limit2), 0.0))) / rr
-    for a in range(n_axes):
-        setpoint[i, a] = pushed[i, a] + alpha * setpoint[i, a]
-    return alpha, np.sqrt(limit2)
-
-
-@numba.njit(cache=True, inline="always")
 def _stiffness(near, crowd, mean):
     """``omega^2 / im_r^2`` of the slow mode an agent with ``near`` neighbours and ``crowd`` contacts
     oscillates in (T2): 1 against walls alone (``A - B K``), 2 for a pair (``A - 2 B K``, within 3 %),
@@ -297,7 +182,7 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
     pressing = 0.0
     obstacles_virial = 0.0
     if bounded:
-        contacts, pressing, work[i, WALL_PUSH], work[i, WALL_MOMENT], obstacles_virial = _wall_pushes(
+        contacts, pressing, work[i, WALL_PUSH], work[i, WALL_MOMENT], obstacles_virial = wall_pushes(
             i, corrected, pushed, walls, obstacles, box, wall_params, n_axes)  # fmt: skip
     kept[i, CROWD] = work[i, CONTACT] + pressing
     if not first:  # the neighbours present at the start are not encounters
@@ -314,9 +199,9 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
     else:  # each pair's half
         work[i, VIRIAL] *= 0.5
     if contacts > 0:  # what the walls drop of the others becomes the walls' own push (W2)
-        held, held_moment, dropped_virial = _keep_off(i, corrected, setpoint, walls, obstacles, box, wall_params.reach,
+        held, held_moment, dropped_virial = keep_off(i, corrected, setpoint, walls, obstacles, box, wall_params.reach,
                                                       n_axes)  # fmt: skip
-        others, kept[i, LIMIT] = _with_priority(i, setpoint, pushed, wall_params.c_max, n_axes)
+        others, kept[i, LIMIT] = with_priority(i, setpoint, pushed, wall_params.c_max, n_axes)
         work[i, WALL_PUSH] += others * held
         work[i, WALL_MOMENT] += others * held_moment
         work[i, VIRIAL] = others * (work[i, VIRIAL] + dropped_virial) + obstacles_virial
@@ -334,7 +219,7 @@ def gas_pushes(known, agents, gas, wall_params, run):
         The states as measured.
     agents, gas, run
         The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.
-    wall_params : FunctionParams
+    wall_params : tmem.interaction.kernels.FunctionParams
         The repulsion's parameters with ``R + R_w`` for its reach.
     """
     box = run.box
@@ -350,7 +235,7 @@ def gas_pushes(known, agents, gas, wall_params, run):
 
 @numba.njit(cache=True, inline="always")
 def tilt_limit(observe, kept, i, c_max):
-    """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`_with_priority`).
+    """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`tmem.engine.walls.with_priority`).
 
     Parameters
     ----------
@@ -435,19 +320,6 @@ def record_totals(agents, gas, records, q, n_axes):
                 if gas.walls[a] > 0.0:
                     records.gas[q, n_totals + 2] += (agents.state[i, a, 0] - 0.5 * gas.walls[a]) * agents.state[i, a, 1]
             records.gas[q, n_totals + 1] += 1.0
-
-
-def wall_params(params: FunctionParams, wall_reach: float) -> FunctionParams:
-    """The repulsion's parameters for walls and obstacles: the law's, with ``R + R_w`` for the reach.
-
-    Parameters
-    ----------
-    params : FunctionParams
-        The interaction functions' parameters.
-    wall_reach : float
-        ``R + R_w`` (m).
-    """
-    return params._replace(reach=float(wall_reach))
 
 
 def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
