@@ -147,9 +147,9 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
     A pair whose agent was removed uncouples and rests.  The step loop calls it for every pair
     (:func:`formation_pairs`), and :mod:`tmem.batch` for each encounter of a batch.
 
-    Called, not inlined: compiled once and shared by the serial and threaded loops and the batch,
-    where each inlined copy of it (with the energy rule and the synchronisation inside) added
-    seconds to the first run's compilation.  It allocates nothing, so it runs without Numba's runtime.
+    Inlined into the loops and the batch; what only the energy rule and the synchronisation need
+    (:func:`tmem.coupling.function_gap`, :func:`synchronise`) is called, so that their copies of the
+    interaction functions are compiled once.
 
     Parameters
     ----------
