@@ -119,21 +119,26 @@ def coverage(
     positions, time, active = _check_records(positions, time, active)
     dims = min(positions.shape[2], 2)
     sides, cell, sensor_radius = check_sizes(box, cell, sensor_radius, positions.shape[2])
-    circles = check_obstacles(obstacles, dims)
     shape = grid_shape(sides[:dims], cell)
-    field = field_cells(shape, cell, circles)
-    first = np.full(field.size, np.nan)
+    field = field_cells(shape, cell, check_obstacles(obstacles, dims))
     longest = sides[:dims] / 2 if periodic else np.full(dims, np.inf)
+    first_visit, share = _visits(positions, time, active, sides[:dims], longest, cell, field, sensor_radius)
+    for array in (time, share, first_visit, field):
+        array.setflags(write=False)
+    return Coverage(time, share, first_visit, field, cell, tuple(float(s) for s in sides))
+
+
+def _visits(positions, time, active, sides, longest, cell, field, radius) -> tuple[np.ndarray, np.ndarray]:
+    """Each cell's first visit (NaN: never, or not in the field) and the share of the field visited
+    at each record, going through the records one at a time (:func:`record_visits`)."""
+    first = np.full(field.size, np.nan)
     for k in range(len(time)):
-        for index, when in record_visits(positions, time, active, k, sides[:dims], longest, cell, shape, sensor_radius):
+        for index, when in record_visits(positions, time, active, k, sides, longest, cell, field.shape, radius):
             np.fmin.at(first, index, when)
     first[~field.ravel()] = np.nan
     visited = np.sort(first[np.isfinite(first)])
     share = np.searchsorted(visited, time, side="right") / np.count_nonzero(field)
-    first_visit = first.reshape(shape)
-    for array in (time, share, first_visit, field):
-        array.setflags(write=False)
-    return Coverage(time, share, first_visit, field, cell, tuple(float(s) for s in sides))
+    return first.reshape(field.shape), share
 
 
 def _check_records(positions, time, active) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
