@@ -27,7 +27,8 @@ fraction of the field's cells with ``first_visit <= time[k]``.
 
 The package, one idea a module:
 
-* :mod:`~tmem.coverage.metric` — :func:`coverage`, the metric, and its result :class:`Coverage`;
+* :mod:`~tmem.coverage.metric` — :func:`~tmem.coverage.metric.coverage`, the metric, and its result
+  :class:`~tmem.coverage.metric.Coverage`;
 * :mod:`~tmem.coverage.grid` — the grid of cells and the field, from the box and the obstacles;
 * :mod:`~tmem.coverage.paths` — the cells an agent visits at a record and on its way there;
 * :mod:`~tmem.coverage.figure` — the map of first visits as a figure;

@@ -240,7 +240,7 @@ class Scenario(StrictModel):
                     raise FieldError(f"agents[{k}].position", f"{place.tolist()} lies inside obstacles[{o}]")
 
     def _check_coverage(self) -> None:
-        """A coverage map needs a walled box, and at most :data:`tmem.coverage.MAX_CELLS` cells."""
+        """A coverage map needs a walled box, and at most :data:`~tmem.coverage.grid.MAX_CELLS` cells."""
         settings = self.coverage
         if settings is None:
             return
