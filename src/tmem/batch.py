@@ -285,20 +285,7 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
         scenario a batch cannot run, starts of the wrong shape, not finite,
         or two agents at one place.
     """
-    if not isinstance(scenario, Scenario):
-        raise ValueError(f"run_batch: scenario: must be a tmem Scenario, got {type(scenario).__name__}")
-    reason = unsupported(scenario)
-    if reason:
-        raise ValueError(f"run_batch: {reason}")
-    n_axes = scenario.space.axes
-    positions = _starts("positions", positions, None, n_axes)
-    velocities = _starts("velocities", velocities, len(positions), n_axes)
-    same = np.flatnonzero(np.all(positions[:, 0] == positions[:, 1], axis=1))
-    if len(same):
-        raise ValueError(
-            f"run_batch: positions[{same[0]}]: both agents at {positions[same[0], 0].tolist() if n_axes > 1 else positions[same[0], 0, 0]}: "
-            "two agents at one point have no direction to part in"
-        )
+    positions, velocities = _checked_starts(scenario, positions, velocities)
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
     linearisation = model.linearisation()
@@ -306,27 +293,18 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     command_step = sim.step_of(scenario.commands[0].time) if scenario.commands else -1
     hold = model.step_params(sim.dt)
     cases = len(positions)
-    starts = np.zeros((cases, 2, n_axes, 4))
+    starts = np.zeros((cases, 2, scenario.space.axes, 4))
     starts[..., 0] = positions
     starts[..., 1] = velocities
     min_dist = np.empty(cases)
     couple_step = np.empty(cases, dtype=np.int64)
     uncouple_step = np.empty(cases, dtype=np.int64)
-    if n_axes == 1 and law.uncouple_rule == coupling.UNCOUPLE_BY_WINDOW and law.sync_gain == 0.0:
-        relative = starts[:, 1, 0] - starts[:, 0, 0]
-        e_end = np.empty((cases, 4))
-        run_relative(relative, sim.n_steps, sim.dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step)
-        total_end = (starts[:, 1, 0] + starts[:, 0, 0]) @ np.linalg.matrix_power(hold.ad, sim.n_steps).T  # the sum flies free
-        final_velocities = np.stack([(total_end[:, 1] - e_end[:, 1]) / 2, (total_end[:, 1] + e_end[:, 1]) / 2], axis=1)[:, :, None]
-        final_distance = np.abs(e_end[:, 0])
-        rule = np.where(uncouple_step >= 0, coupling.RELEASES.index("window"), -1)
+    written = (min_dist, couple_step, uncouple_step)
+    steps = (sim.n_steps, sim.dt, command_step, hold, law, params)
+    if scenario.space.axes == 1 and law.uncouple_rule == coupling.UNCOUPLE_BY_WINDOW and law.sync_gain == 0.0:
+        final_velocities, final_distance, rule = _fly_relative(starts, steps, written)
     else:
-        ends = np.empty_like(starts)
-        rule = np.empty(cases, dtype=np.int64)
-        _run_batch(starts, sim.n_steps, sim.dt, command_step, hold, law, params, (0.0,) * n_axes,
-                   ends, min_dist, couple_step, uncouple_step, rule)  # fmt: skip
-        final_velocities = ends[..., 1]
-        final_distance = np.linalg.norm(ends[:, 1, :, 0] - ends[:, 0, :, 0], axis=1)
+        final_velocities, final_distance, rule = _fly_pairs(starts, steps, written)
     rms0 = np.sqrt((velocities**2).sum(axis=2).mean(axis=1))
     rms1 = np.sqrt((final_velocities**2).sum(axis=2).mean(axis=1))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -342,3 +320,53 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
         uncouple_rule=np.array([coupling.RELEASES[r] if r >= 0 else None for r in rule], dtype=object),
         final_velocities=final_velocities,
     )
+
+
+def _checked_starts(scenario: Scenario, positions, velocities) -> tuple[np.ndarray, np.ndarray]:
+    """The starts as arrays of shape (cases, 2, axes), the scenario and the starts checked as
+    :func:`run_batch` says."""
+    if not isinstance(scenario, Scenario):
+        raise ValueError(f"run_batch: scenario: must be a tmem Scenario, got {type(scenario).__name__}")
+    reason = unsupported(scenario)
+    if reason:
+        raise ValueError(f"run_batch: {reason}")
+    n_axes = scenario.space.axes
+    positions = _starts("positions", positions, None, n_axes)
+    velocities = _starts("velocities", velocities, len(positions), n_axes)
+    same = np.flatnonzero(np.all(positions[:, 0] == positions[:, 1], axis=1))
+    if len(same):
+        raise ValueError(
+            f"run_batch: positions[{same[0]}]: both agents at {positions[same[0], 0].tolist() if n_axes > 1 else positions[same[0], 0, 0]}: "
+            "two agents at one point have no direction to part in"
+        )
+    return positions, velocities
+
+
+def _fly_relative(starts: np.ndarray, steps: tuple, written: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The paper's case on one axis, on the pair's relative state (:mod:`tmem.relative_batch`); the sum
+    of the states flies free.  ``steps``: ``(n_steps, dt, command_step, hold, law, params)``;
+    ``written``: ``(min_dist, couple_step, uncouple_step)``, filled.  Returns the final velocities,
+    the final distances and each case's release rule."""
+    n_steps, dt, command_step, hold, law, params = steps
+    min_dist, couple_step, uncouple_step = written
+    relative = starts[:, 1, 0] - starts[:, 0, 0]
+    e_end = np.empty((len(starts), 4))
+    run_relative(relative, n_steps, dt, command_step, hold, law, params, e_end, min_dist, couple_step, uncouple_step)
+    total_end = (starts[:, 1, 0] + starts[:, 0, 0]) @ np.linalg.matrix_power(hold.ad, n_steps).T  # the sum flies free
+    final_velocities = np.stack([(total_end[:, 1] - e_end[:, 1]) / 2, (total_end[:, 1] + e_end[:, 1]) / 2], axis=1)[:, :, None]
+    final_distance = np.abs(e_end[:, 0])
+    rule = np.where(uncouple_step >= 0, coupling.RELEASES.index("window"), -1)
+    return final_velocities, final_distance, rule
+
+
+def _fly_pairs(starts: np.ndarray, steps: tuple, written: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Both agents of every case stepped (:func:`_run_batch`); arguments and results as :func:`_fly_relative`'s."""
+    n_steps, dt, command_step, hold, law, params = steps
+    min_dist, couple_step, uncouple_step = written
+    ends = np.empty_like(starts)
+    rule = np.empty(len(starts), dtype=np.int64)
+    _run_batch(starts, n_steps, dt, command_step, hold, law, params, (0.0,) * starts.shape[2],
+               ends, min_dist, couple_step, uncouple_step, rule)  # fmt: skip
+    final_velocities = ends[..., 1]
+    final_distance = np.linalg.norm(ends[:, 1, :, 0] - ends[:, 0, :, 0], axis=1)
+    return final_velocities, final_distance, rule

@@ -112,6 +112,28 @@ def contents(trajectory: Trajectory) -> Contents:
         A run (:func:`tmem.simulate`).
     """
     order = np.argsort(trajectory.agents, kind="stable")
+    data = _per_agent(trajectory, order)
+    data["F_en"] = (OVER_PAIRS, trajectory.flag.T.astype(np.int8), {"long_name": "pair coupling flag F_en", "units": "1"})
+    data["distance"] = (OVER_PAIRS, trajectory.pair_distance.T, {"long_name": "distance |P_j - P_i|", "units": "m"})
+    data["interaction_distance"] = (
+        OVER_PAIRS,
+        trajectory.interaction_distance.T,
+        {"long_name": "interaction distance |P*_j - P*_i|, (6)", "units": "m"},
+    )
+    data["d_t"] = (("pair",), trajectory.d_t, {"long_name": "set distance of the pair", "units": "m"})
+    data["rms_velocity"] = (
+        ("time",),
+        metrics.rms_velocity(trajectory.model.velocity(trajectory.state), trajectory.active),
+        {"long_name": "RMS velocity over the recorded agents flying", "units": "m s-1"},
+    )
+    if trajectory.gas.shape[1]:
+        for c, (name, (long_name, units)) in enumerate(COLUMNS.items()):
+            data[f"gas_{name}"] = (("time",), trajectory.gas[:, c], {"long_name": long_name, "units": units})
+    return Contents(_coordinates(trajectory, order), data, _file_attributes(trajectory))
+
+
+def _per_agent(trajectory: Trajectory, order: np.ndarray) -> dict:
+    """The variables over (agent, time), the agents in ``order``, and the grid mapping they name."""
     model = trajectory.model
     data = {}
     for m, (name, long_name, units) in enumerate(zip(model.state_names, model.long_names, model.state_units)):
@@ -124,23 +146,12 @@ def contents(trajectory: Trajectory) -> Contents:
     for _, _, attrs in data.values():  # every per-agent variable is located in the frame
         attrs["grid_mapping"] = GRID_MAPPING
     data[GRID_MAPPING] = ((), np.array(0, dtype=np.int32), dict(GRID_MAPPING_ATTRS))
-    data["F_en"] = (OVER_PAIRS, trajectory.flag.T.astype(np.int8), {"long_name": "pair coupling flag F_en", "units": "1"})
-    data["distance"] = (OVER_PAIRS, trajectory.pair_distance.T, {"long_name": "distance |P_j - P_i|", "units": "m"})
-    data["interaction_distance"] = (
-        OVER_PAIRS,
-        trajectory.interaction_distance.T,
-        {"long_name": "interaction distance |P*_j - P*_i|, (6)", "units": "m"},
-    )
-    data["d_t"] = (("pair",), trajectory.d_t, {"long_name": "set distance of the pair", "units": "m"})
-    data["rms_velocity"] = (
-        ("time",),
-        metrics.rms_velocity(model.velocity(trajectory.state), trajectory.active),
-        {"long_name": "RMS velocity over the recorded agents flying", "units": "m s-1"},
-    )
-    if trajectory.gas.shape[1]:
-        for c, (name, (long_name, units)) in enumerate(COLUMNS.items()):
-            data[f"gas_{name}"] = (("time",), trajectory.gas[:, c], {"long_name": long_name, "units": units})
-    attrs = {
+    return data
+
+
+def _file_attributes(trajectory: Trajectory) -> dict:
+    """The file's attributes: conventions, provenance, the scenario as TOML, the gains, the events."""
+    return {
         "Conventions": CONVENTIONS,
         "featureType": "trajectory",
         "title": f"tmem run {trajectory.scenario.name}".strip(),
@@ -153,7 +164,6 @@ def contents(trajectory: Trajectory) -> Contents:
         "gains_order": "K_P K_V K_phi K_omega",
         "events": json.dumps(metrics.summarize_events(trajectory.events)),
     }
-    return Contents(_coordinates(trajectory, order), data, attrs)
 
 
 def to_dataset(trajectory: Trajectory):

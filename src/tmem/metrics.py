@@ -343,7 +343,7 @@ def summarize(trajectory: Trajectory) -> dict:
     The RMS velocity and its change: :func:`rms_summary`; coupling:
     :func:`coupling_summary`; the gas's observables (when observed):
     :func:`tmem.observables.gas_summary`; the coverage of a walled box:
-    :func:`tmem.coverage.coverage_summary`.  ``min_distance`` is the smallest distance two
+    :func:`~tmem.coverage.runs.coverage_summary`.  ``min_distance`` is the smallest distance two
     agents reached at any step (formation pairs always; other pairs once within
     ``R + R_j``); ``final_distance`` the smallest distance between two flying
     agents at the end.  Every number is finite: ``None`` (JSON ``null``) stands

@@ -40,6 +40,59 @@ def _free_flight_steps(d, velocity, steps_left, gap, dt):
     return min(steps_left, int(gap / (closing * dt)) - 1)
 
 
+@numba.njit(cache=True, inline="always")
+def _lane_states(e0, first, lanes):
+    """The relative states ``(P, V, phi, omega)`` of the ``lanes`` cases from ``first``, one array each
+    of :data:`LANES` slots."""
+    e_p = np.empty(LANES)
+    e_v = np.empty(LANES)
+    e_phi = np.empty(LANES)
+    e_om = np.empty(LANES)
+    for lane in range(lanes):
+        e_p[lane], e_v[lane], e_phi[lane], e_om[lane] = e0[first + lane]
+    return e_p, e_v, e_phi, e_om
+
+
+@numba.njit(cache=True, inline="always")
+def _skip_free_flight(e_p, e_v, armed, r_before, k, c, d, gap, n_steps, command_step, dt):
+    """Skip case ``c``'s free flight in closed form (:func:`_free_flight_steps`), the command disarming
+    it if due on the way; whether there was more than one step to skip."""
+    skip = _free_flight_steps(d, e_v[c], n_steps - k[c], gap, dt)
+    if skip <= 1:
+        return False
+    if k[c] < command_step <= k[c] + skip:
+        armed[c] = 0
+    e_p[c] += e_v[c] * (skip * dt)
+    k[c] += skip
+    r_before[c] = np.nan
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _flag_step(flag, armed, r_before, coupled_at, uncoupled_at, c, step, r, d_t, eps, at_crossing):
+    """Case ``c``'s flag ``F_en`` after its measure reached ``r`` at ``step`` (condition (9),
+    :func:`tmem.coupling.next_flag`), and the first steps it coupled and uncoupled."""
+    new = coupling.next_flag(flag[c], armed[c], r_before[c], r, d_t, eps, at_crossing)
+    if new != flag[c]:
+        if new == 1 and coupled_at[c] < 0:
+            coupled_at[c] = step
+        if new == 0 and uncoupled_at[c] < 0:
+            uncoupled_at[c] = step
+        flag[c] = new
+    r_before[c] = r
+
+
+@numba.njit(cache=True, inline="always")
+def _push_on_first(function, r, f_en, params, d, c_max):
+    """``U_0``: the pair's push on its first agent at measure ``r = |d|`` (8), its sign ``d``'s,
+    saturated to ``c_max``; 0 at ``r = 0``."""
+    u0 = 0.0
+    if r > 0.0:
+        u0 = pair_control(function, r, f_en, params) * (1.0 if d > 0 else -1.0)
+        u0 = min(max(u0, -c_max), c_max)
+    return u0
+
+
 # fastmath "contract" only: the multiply-adds may fuse (one rounding instead of two); NaN and
 # infinity keep their meaning, which the flag logic relies on (r_before is NaN after a skip).
 @numba.njit(cache=True, parallel=True, error_model="numpy", fastmath={"contract"})
@@ -69,10 +122,7 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
     for block in numba.prange((n_cases + LANES - 1) // LANES):
         first = block * LANES
         lanes = min(LANES, n_cases - first)
-        e_p = np.empty(LANES)
-        e_v = np.empty(LANES)
-        e_phi = np.empty(LANES)
-        e_om = np.empty(LANES)
+        e_p, e_v, e_phi, e_om = _lane_states(e0, first, lanes)
         flag = np.zeros(LANES, dtype=np.int64)
         armed = np.ones(LANES, dtype=np.int64)
         r_before = np.full(LANES, np.nan)
@@ -80,8 +130,6 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
         coupled_at = np.full(LANES, -1)
         uncoupled_at = np.full(LANES, -1)
         k = np.zeros(LANES, dtype=np.int64)
-        for lane in range(lanes):
-            e_p[lane], e_v[lane], e_phi[lane], e_om[lane] = e0[first + lane]
         running = lanes
         while running > 0:
             running = 0
@@ -98,27 +146,11 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
                 # d = P + (K_V / K_P) V moves at the constant rate V, so the flight is skipped in
                 # closed form: to the end if the pair separates, else to just before it meets.
                 if flag[c] == 0 and r > reach + eps and abs(e_phi[c]) < 1e-13 and abs(e_om[c]) < 1e-12 and k[c] < n_steps:
-                    skip = _free_flight_steps(d, e_v[c], n_steps - k[c], r - reach - eps, dt)
-                    if skip > 1:
-                        if k[c] < command_step <= k[c] + skip:
-                            armed[c] = 0
-                        e_p[c] += e_v[c] * (skip * dt)
-                        k[c] += skip
-                        r_before[c] = np.nan
+                    if _skip_free_flight(e_p, e_v, armed, r_before, k, c, d, r - reach - eps, n_steps, command_step, dt):
                         continue
                 if couples:
-                    new = coupling.next_flag(flag[c], armed[c], r_before[c], r, d_t, eps, at_crossing)
-                    if new != flag[c]:
-                        if new == 1 and coupled_at[c] < 0:
-                            coupled_at[c] = k[c]
-                        if new == 0 and uncoupled_at[c] < 0:
-                            uncoupled_at[c] = k[c]
-                        flag[c] = new
-                    r_before[c] = r
-                u0 = 0.0
-                if r > 0.0:
-                    u0 = pair_control(function, r, flag[c], params) * (1.0 if d > 0 else -1.0)
-                    u0 = min(max(u0, -c_max), c_max)
+                    _flag_step(flag, armed, r_before, coupled_at, uncoupled_at, c, k[c], r, d_t, eps, at_crossing)
+                u0 = _push_on_first(function, r, flag[c], params, d, c_max)
                 if k[c] < n_steps:
                     e_p[c], e_v[c], e_phi[c], e_om[c] = hold_step(ad, bd, e_p[c], e_v[c], e_phi[c], e_om[c], -2.0 * u0)
                 k[c] += 1

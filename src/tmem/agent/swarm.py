@@ -189,20 +189,7 @@ def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None
         As :func:`controllers_for`, where ``controllers`` do not fit the scenario, or where the
         scenario has sensing effects (the per-agent loop passes every message exactly).
     """
-    _refuse_what_is_not_flown(scenario)
-    if scenario.sensing is not None and not scenario.sensing.exact:
-        raise ControllerError("sensing: fly() hands every controller every message exactly; noise, delay and loss "
-                              "are tmem.simulate's measurement stage, or the bridge's own")  # fmt: skip
-    if controllers is None:
-        controllers = controllers_for(scenario)
-    else:
-        controllers = list(controllers)
-        fits = [c.agent for c in controllers] == list(range(scenario.n_agents))
-        if not fits or any(c.settings.axes != scenario.space.axes for c in controllers):
-            raise ControllerError(f"controllers: needs one per agent, agents 0..{scenario.n_agents - 1} in order, "
-                                  f"on {scenario.space.axes} axes")  # fmt: skip
-        for controller in controllers:
-            controller.reset()
+    controllers = _controllers_to_fly(scenario, controllers)
     sim = scenario.simulation
     model = vehicle_model(scenario.model, scenario.wind)
     vehicle_step, hold = type(model).step, model.step_params(sim.dt)  # the class's kernel, not a bound method
@@ -234,3 +221,21 @@ def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None
             for i in range(n):
                 vehicle_step(x, body, u, i, 1.0, hold, n_axes)
     return Flight(steps * sim.dt, recorded, state, control, flag, events, x, controllers)
+
+
+def _controllers_to_fly(scenario: Scenario, controllers: Sequence[AgentController] | None) -> list[AgentController]:
+    """The controllers :func:`fly` flies ``scenario`` with, reset; refused as :func:`fly` says."""
+    _refuse_what_is_not_flown(scenario)
+    if scenario.sensing is not None and not scenario.sensing.exact:
+        raise ControllerError("sensing: fly() hands every controller every message exactly; noise, delay and loss "
+                              "are tmem.simulate's measurement stage, or the bridge's own")  # fmt: skip
+    if controllers is None:
+        return controllers_for(scenario)
+    controllers = list(controllers)
+    fits = [c.agent for c in controllers] == list(range(scenario.n_agents))
+    if not fits or any(c.settings.axes != scenario.space.axes for c in controllers):
+        raise ControllerError(f"controllers: needs one per agent, agents 0..{scenario.n_agents - 1} in order, "
+                              f"on {scenario.space.axes} axes")  # fmt: skip
+    for controller in controllers:
+        controller.reset()
+    return controllers

@@ -99,7 +99,13 @@ def animate(
     run = read_frames(run_dir, max_frames)
     writer = writer_for(out, fps)
     check_file(out, label=label)
+    _write(run, writer, out, label, dpi)
+    return out
 
+
+def _write(run, writer, out: Path, label: str, dpi: int) -> None:
+    """Draw the figure once, then every frame of ``run`` over it into ``writer``, under a temporary
+    name beside ``out`` that becomes ``out`` when the last frame is in."""
     shown, cross = positions(run)
     with warnings.catch_warnings():  # a name in a script the font lacks is drawn as boxes, without a warning per glyph
         warnings.filterwarnings("ignore", message=r"Glyph \d+ .* missing from font", category=UserWarning)
@@ -117,4 +123,3 @@ def animate(
             abandon(writer)
             raise
         writer.finish()
-    return out

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .. import coupling
 from ..control import gains_for, interaction_point
 from ..initial import InitialArrays, build
 from ..model import vehicle_model
@@ -37,7 +36,7 @@ from .law import law_of
 from .records import (
     COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
-from .trajectory import DIVERGED, Event, SimulationError, Trajectory
+from .trajectory import DIVERGED, SimulationError, Trajectory, read_events
 from .walls import wall_params
 
 #: Swarms at least this large step on threads: below, starting the threads at every step costs more
@@ -150,30 +149,6 @@ def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n
 
 def _events(capacity: int) -> Events:
     return Events(*(np.empty(capacity, dtype=np.int64) for _ in Events._fields))
-
-
-def read_events(events: Events, n_events: int, order: np.ndarray, dt: float) -> list[Event]:
-    """The first ``n_events`` events of a loop's record, with agents named by ``order[slot]``.
-
-    Parameters
-    ----------
-    events : Events
-        The record the loop logged them in (:func:`tmem.engine.stages.log_event`).
-    n_events : int
-        How many it logged.
-    order : ndarray
-        The agent in each slot.
-    dt : float
-        The time step (s): an event at step ``k`` happened at ``k dt``.
-    """
-    found = []
-    for e in range(n_events):
-        kind = coupling.EVENT_KINDS[events.kind[e]]
-        agents = tuple(int(order[v]) for v in (events.i[e], events.j[e]) if v >= 0)
-        action = COMMANDS[events.action[e]] if kind == "command" else None
-        rule = coupling.RELEASES[events.rule[e]] if events.rule[e] >= 0 else None
-        found.append(Event(time=round(float(events.step[e] * dt), 12), kind=kind, agents=agents, action=action, rule=rule))
-    return found
 
 
 @dataclass
@@ -297,6 +272,14 @@ def simulate(
     _drive(advance, run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)
     if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
+    return _read_back(scenario, initial, model, gains, swarm, lister)
+
+
+def _read_back(scenario: Scenario, initial: InitialArrays, model, gains: np.ndarray, swarm: _Slots,
+               lister: _NeighbourLister) -> Trajectory:  # fmt: skip
+    """The trajectory of a finished run, its agents translated from slots back to their numbers."""
+    sim = scenario.simulation
+    x = swarm.agents.state
     return Trajectory(
         scenario=scenario,
         initial=initial,

@@ -1,4 +1,4 @@
-"""What a run produced: the trajectory, its events, and a run that failed."""
+"""What a run produced: the trajectory, its events (read back from the loop's record), and a run that failed."""
 
 from __future__ import annotations
 
@@ -6,9 +6,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import coupling
 from ..initial import InitialArrays
 from ..model.base import VehicleModel
 from ..scenario import Scenario
+from .records import COMMANDS, Events
 
 
 class SimulationError(ValueError):
@@ -115,3 +117,27 @@ class Trajectory:
     def d_t(self) -> np.ndarray:
         """Set distance of each pair, shape (n_pairs,)."""
         return self.initial.d_t
+
+
+def read_events(events: Events, n_events: int, order: np.ndarray, dt: float) -> list[Event]:
+    """The first ``n_events`` events of a loop's record, with agents named by ``order[slot]``.
+
+    Parameters
+    ----------
+    events : Events
+        The record the loop logged them in (:func:`tmem.engine.stages.log_event`).
+    n_events : int
+        How many it logged.
+    order : ndarray
+        The agent in each slot.
+    dt : float
+        The time step (s): an event at step ``k`` happened at ``k dt``.
+    """
+    found = []
+    for e in range(n_events):
+        kind = coupling.EVENT_KINDS[events.kind[e]]
+        agents = tuple(int(order[v]) for v in (events.i[e], events.j[e]) if v >= 0)
+        action = COMMANDS[events.action[e]] if kind == "command" else None
+        rule = coupling.RELEASES[events.rule[e]] if events.rule[e] >= 0 else None
+        found.append(Event(time=round(float(events.step[e] * dt), 12), kind=kind, agents=agents, action=action, rule=rule))
+    return found

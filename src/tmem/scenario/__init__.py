@@ -7,27 +7,32 @@ values out of range are refused with :class:`ScenarioError`, a one-line
 message naming the field and the reason.  Defaults are documented in
 ``docs/parameters.md``.
 
-* :mod:`~tmem.scenario.tables` — one pydantic model per table, and the number types;
+* :mod:`~tmem.scenario.tables` — the tables' base class and number types; the model, controller,
+  interaction, simulation and neighbour tables;
+* :mod:`~tmem.scenario.agents_table` — the ``[[agents]]`` and ``[swarm]`` tables;
+* :mod:`~tmem.scenario.space_table` — the ``[space]``, ``[[obstacles]]``, ``[coverage]`` and ``[thermostat]`` tables;
+* :mod:`~tmem.scenario.formation_table` — the ``[formation]`` table and its checks against the scenario;
+* :mod:`~tmem.scenario.commands_table` — the ``[[commands]]`` table and its checks against the scenario;
 * :mod:`~tmem.scenario.schema` — :class:`Scenario`, the tables checked against each other;
+* :mod:`~tmem.scenario.budget` — the memory a run needs and the size of its records;
 * :mod:`~tmem.scenario.sensing_table` — the ``[sensing]`` table and its checks against the scenario;
 * :mod:`~tmem.scenario.wind_table` — the ``[wind]`` table (the quadrotor's wind) and its checks;
 * :mod:`~tmem.scenario.files` — reading, writing and editing files; the presets.
 """
 
+from .agents_table import Agent, SwarmParams, Vector
+from .budget import MAX_RECORD_BYTES
+from .commands_table import Command
 from .files import PRESETS, describe, from_dict, load, loads, preset, read_text, with_changes
-from .schema import MAX_AGENTS_ALL_PAIRS, MAX_RECORD_BYTES, TRACK_ALL_PAIRS, Scenario
+from .formation_table import FormationParams
+from .schema import MAX_AGENTS_ALL_PAIRS, TRACK_ALL_PAIRS, Scenario
 from .sensing_table import SensingParams
-from .wind_table import TurbulenceParams, WindParams
+from .space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
 from .tables import (
     LIMIT,
     MODEL_KINDS,
-    Agent,
-    Command,
-    Obstacle,
     ControllerParams,
-    CoverageParams,
     FieldError,
-    FormationParams,
     InteractionParams,
     LinearModelParams,
     ModelParams,
@@ -39,12 +44,9 @@ from .tables import (
     QuadrotorModelParams,
     ScenarioError,
     SimulationParams,
-    SpaceParams,
     StrictModel,
-    SwarmParams,
-    ThermostatParams,
-    Vector,
 )
+from .wind_table import TurbulenceParams, WindParams
 
 __all__ = [
     "LIMIT",

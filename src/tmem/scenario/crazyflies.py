@@ -25,7 +25,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .tables import AGENT_NAME, ScenarioError
+from .agents_table import AGENT_NAME
+from .tables import ScenarioError
 
 #: The scenario key naming the file.
 KEY = "agents_from"

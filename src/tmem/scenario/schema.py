@@ -3,8 +3,9 @@
 A scenario is a TOML file with the tables ``[model]`` (Table 1),
 ``[controller]`` (roots (5)), ``[interaction]``, ``[simulation]``,
 ``[[agents]]`` (Table 2) and ``[[commands]]``, and optionally ``[space]``,
-``[neighbors]``, ``[formation]``, ``[swarm]``, ``[sensing]`` and ``[wind]`` (:mod:`tmem.scenario.tables`,
-:mod:`tmem.scenario.sensing_table`, :mod:`tmem.scenario.wind_table`).
+``[neighbors]``, ``[formation]``, ``[swarm]``, ``[sensing]`` and ``[wind]`` (:mod:`tmem.scenario.tables`
+and the ``*_table`` modules beside it; a table's checks against the others live with it where they
+concern that table alone, the memory a run needs in :mod:`tmem.scenario.budget`).
 Every key is checked: unknown keys, non-finite numbers and values out of range
 are refused; :func:`tmem.scenario.files.describe` turns the errors into the one
 line of a :class:`ScenarioError`.  Defaults are documented in
@@ -14,7 +15,6 @@ line of a :class:`ScenarioError`.  Defaults are documented in
 from __future__ import annotations
 
 import math
-import os
 import unicodedata
 
 import numpy as np
@@ -23,30 +23,25 @@ from pydantic import field_validator, model_validator
 from ..coverage import MAX_CELLS
 from ..formation import generate
 from ..interaction.registry import uses_coupling
+from .agents_table import Agent, SwarmParams, check_agents
+from .budget import check_memory, check_record_size, memory_limit
+from .commands_table import Command, check_commands
+from .formation_table import FormationParams, check_formation
+from .sensing_table import SensingParams, check_sensing
+from .space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
 from .tables import (
-    Agent,
-    Command,
     ControllerParams,
-    CoverageParams,
     FieldError,
-    FormationParams,
     InteractionParams,
     LinearModelParams,
     ModelParams,
     NeighborParams,
-    Obstacle,
     SimulationParams,
-    SpaceParams,
     StrictModel,
-    SwarmParams,
-    ThermostatParams,
     per_axis,
 )
-from .sensing_table import SensingParams, check_sensing
 from .wind_table import WindParams, check_wind
 
-#: Most bytes a run may set aside for its records.
-MAX_RECORD_BYTES = 8 * 2**30
 #: Beyond this many agents, a coupling function needs a [formation]: without one every pair
 #: would be a formation pair, and their number grows as the square of the swarm.
 MAX_AGENTS_ALL_PAIRS = 2000
@@ -63,27 +58,6 @@ MAX_NAME_LENGTH = 200
 MAX_ROOT_DT = 0.15
 #: Smallest position gain K_P: below it the gains (4) lose their precision and soon underflow to 0.
 MIN_K_P = 1e-150
-#: Bytes of working memory a run needs per agent and axis (state, its copy, the control, the
-#: neighbour search's cells) and per agent (Verlet pairs, found lists, sort order), rounded up.
-WORK_BYTES_PER_AGENT_AXIS = 128
-WORK_BYTES_PER_AGENT = 256
-#: Bytes of the gas's work space per agent and per agent and axis, when it is observed
-#: (:class:`tmem.engine.records.Gas`: 18 numbers, and the walls' push on each axis).
-GAS_BYTES_PER_AGENT = 144
-GAS_BYTES_PER_AGENT_AXIS = 8
-#: Bytes per tracked pair while running (flag, distances, both directions of the edge), rounded up.
-WORK_BYTES_PER_PAIR = 96
-
-
-def memory_limit() -> int:
-    """Most bytes a run may need: 16 GiB, or half this machine's memory if that is less."""
-    try:
-        physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (AttributeError, ValueError, OSError):
-        physical = 0
-    return min(16 * 2**30, physical // 2) if physical > 0 else 16 * 2**30
-
-
 class Scenario(StrictModel):
     """A whole scenario; see the module docstring.
 
@@ -179,7 +153,7 @@ class Scenario(StrictModel):
     def _consistent(self) -> "Scenario":
         axes = self.space.axes
         self._check_sources()
-        self._check_agents(axes)
+        check_agents(self, axes)
         n = self.n_agents
         if n < 2:
             raise FieldError("agents", f"needs at least 2 agents, got {n}")
@@ -192,7 +166,7 @@ class Scenario(StrictModel):
         self._check_coverage()
         self._check_sampling()
         if self.formation is not None:
-            self._check_formation(axes, n)
+            check_formation(self, axes, n)
         elif uses_coupling(self.interaction.function) and n > MAX_AGENTS_ALL_PAIRS:
             raise FieldError(
                 "interaction.function",
@@ -210,7 +184,7 @@ class Scenario(StrictModel):
             for k, a in enumerate(self.simulation.record_agents):
                 if not 0 <= a < n:
                     raise FieldError(f"simulation.record_agents[{k}]", f"names agent {a}, outside 0..{n - 1}")
-        self._check_memory(n)  # before generating anything
+        check_memory(self, n, self._pair_count(n))  # before generating anything
         check_sensing(self, n, self.neighbors.uses_lists(n), memory_limit())
         check_wind(self)
         pairs = self.pairs()  # generating a large formation is not free: once per validation
@@ -218,8 +192,8 @@ class Scenario(StrictModel):
             raise FieldError(
                 "simulation.record_agents", "is empty and there are no pairs to record: the run would record nothing"
             )
-        self._check_commands(n, pairs)
-        self._check_record_size(n, len(pairs))
+        check_commands(self, n, pairs)
+        check_record_size(self, n, len(pairs))
         self._check_formation_room(axes, n)
         return self
 
@@ -266,7 +240,7 @@ class Scenario(StrictModel):
                     raise FieldError(f"agents[{k}].position", f"{place.tolist()} lies inside obstacles[{o}]")
 
     def _check_coverage(self) -> None:
-        """A coverage map needs a walled box, and at most :data:`tmem.coverage.MAX_CELLS` cells."""
+        """A coverage map needs a walled box, and at most :data:`~tmem.coverage.grid.MAX_CELLS` cells."""
         settings = self.coverage
         if settings is None:
             return
@@ -326,39 +300,6 @@ class Scenario(StrictModel):
             return n * (n - 1) // 2 if coupled else 0
         return {"chain": n - 1, "ring": n, "triangle": 3, "hex": 3 * n}.get(f.kind, len(f.edges or ()))
 
-    def _check_memory(self, n: int) -> None:
-        sim, axes = self.simulation, self.space.axes
-        pairs = self._pair_count(n)
-        records = sim.n_steps // sim.record_every + 2
-        recorded = n if sim.record_agents is None else len(sim.record_agents)
-        kept = records * (recorded * (5 * axes * 8 + 1) + pairs * 32)
-        per_agent = WORK_BYTES_PER_AGENT + axes * WORK_BYTES_PER_AGENT_AXIS
-        if self.gas_observed:
-            per_agent += GAS_BYTES_PER_AGENT + axes * GAS_BYTES_PER_AGENT_AXIS
-        work = n * per_agent + pairs * WORK_BYTES_PER_PAIR
-        need, limit = kept + work, memory_limit()
-        if need > limit:
-            field = "swarm.n" if self.swarm is not None else ("formation.n" if self.formation and self.formation.n else "agents")
-            if work <= limit:  # the agents fit: their records are what does not
-                field = "simulation.record_every"
-            raise FieldError(
-                field,
-                f"{n} agents would need about {need / 2**30:.3g} GiB to run (at most {limit / 2**30:.3g} GiB); "
-                "fewer agents, or record less (record_every, record_agents)",
-            )
-
-    def _check_record_size(self, n: int, pairs: int) -> None:
-        sim = self.simulation
-        records = sim.n_steps // sim.record_every + 2
-        agents = n if sim.record_agents is None else len(sim.record_agents)
-        size = records * (agents * (5 * self.space.axes * 8 + 1) + pairs * 32)
-        if size > MAX_RECORD_BYTES:
-            raise FieldError(
-                "simulation.record_every",
-                f"the records would take {size / 2**30:.1f} GiB (at most {MAX_RECORD_BYTES / 2**30:g}); "
-                "record less often or fewer agents (record_agents)",
-            )
-
     def _check_sources(self) -> None:
         generated = self.formation is not None and self.formation.kind != "edges"
         sources = [name for name, given in (("agents", bool(self.agents)), ("formation", generated),
@@ -367,95 +308,6 @@ class Scenario(StrictModel):
             raise FieldError(sources[1], f"give the agents once: by {' or '.join(sources)}, not both")
         if not sources:
             raise FieldError("agents", "no agents: give [[agents]], a [formation] or a [swarm]")
-
-    def _check_agents(self, axes: int) -> None:
-        seen: dict[tuple, int] = {}
-        named: dict[str, int] = {}
-        for k, agent in enumerate(self.agents):
-            if agent.name is not None:
-                if agent.name in named:
-                    raise FieldError(f"agents[{k}].name", f"{agent.name!r} is the name of agents[{named[agent.name]}]: "
-                                     "names tell the agents' trajectories apart")  # fmt: skip
-                named[agent.name] = k
-                if agent.name.startswith("agent") and agent.name[5:].isdigit() and agent.name != f"agent{k + 1}":
-                    raise FieldError(f"agents[{k}].name", f"{agent.name!r} is the name an unnamed agent "
-                                     f"{agent.name[5:]} gets (agents are numbered from 1); choose another")  # fmt: skip
-            place = tuple(np.ravel(agent.position).tolist())
-            if place in seen:
-                raise FieldError(
-                    f"agents[{k}].position",
-                    f"is the place of agents[{seen[place]}]: two agents at one point have no direction to part in",
-                )
-            seen[place] = k
-            for name in ("position", "velocity", "tilt", "tilt_rate"):
-                value = getattr(agent, name)
-                if isinstance(value, list) and len(value) != axes:
-                    raise FieldError(f"agents[{k}].{name}", per_axis(axes, len(value)))
-                if not isinstance(value, list) and axes > 1 and (name == "position" or value != 0.0):
-                    raise FieldError(f"agents[{k}].{name}", f"needs a list of {axes} values for axes = {axes}")
-
-    def _check_formation(self, axes: int, n: int) -> None:
-        f = self.formation
-        if not uses_coupling(self.interaction.function):
-            raise FieldError("formation", "needs interaction.function 'switching' (10) or 'improved' (11)")
-        if f.bearing and axes == 1:
-            raise FieldError("formation.bearing", "a direction to hold needs 2 or 3 axes, got axes = 1")
-        if f.kind in ("ring", "triangle", "hex") and axes == 1:
-            raise FieldError("formation.kind", f"{f.kind!r} is planar and needs 2 or 3 axes, got axes = 1")
-        d_t = f.d_t or self.interaction.d_t
-        if d_t >= self.interaction.reach:
-            raise FieldError("formation.d_t", f"must be less than R + R_j = {self.interaction.reach:g} m, got {d_t:g}")
-        for name in ("center", "velocity"):
-            value = getattr(f, name)
-            if value is not None and len(value) != axes:
-                raise FieldError(f"formation.{name}", per_axis(axes, len(value)))
-        if f.kind == "edges":
-            seen = set()
-            for k, edge in enumerate(f.edges):
-                i, j = edge[:2]
-                if not (isinstance(i, int) and isinstance(j, int)):
-                    raise FieldError(f"formation.edges[{k}]", f"needs two agent indices first, got {list(edge)}")
-                if len(edge) == 3 and not 0 < edge[2]:
-                    raise FieldError(f"formation.edges[{k}]", f"d_t must be > 0, got {edge[2]}")
-                if not (0 <= i < n and 0 <= j < n) or i == j:
-                    raise FieldError(f"formation.edges[{k}]", f"needs two different agents in 0..{n - 1}, got {list(edge)}")
-                if len(edge) == 3 and edge[2] >= self.interaction.reach:
-                    raise FieldError(f"formation.edges[{k}]", f"d_t must be less than R + R_j = {self.interaction.reach:g} m")
-                if (min(i, j), max(i, j)) in seen:
-                    raise FieldError(f"formation.edges[{k}]", f"repeats the pair {sorted((i, j))}")
-                seen.add((min(i, j), max(i, j)))
-
-    def _check_commands(self, n: int, formation_pairs: np.ndarray) -> None:
-        pairs = {tuple(e) for e in formation_pairs.tolist()} if self.commands else set()
-        active = [a.active for a in self.agents] if self.agents else [True] * n
-        for k, command in sorted(enumerate(self.commands), key=lambda kc: kc[1].time):
-            where = f"commands[{k}]"
-            if command.action == "couple" and not uses_coupling(self.interaction.function):
-                raise FieldError(
-                    f"{where}.action",
-                    f"'couple' does nothing: interaction.function {self.interaction.function!r} has no coupling flag "
-                    "(use 'switching' (10) or 'improved' (11))",
-                )
-            if command.time > self.simulation.duration:
-                raise FieldError(
-                    f"{where}.time", f"must not be later than duration = {self.simulation.duration:g} s, got {command.time:g}"
-                )
-            if command.agent is not None:
-                if not 0 <= command.agent < n:
-                    raise FieldError(f"{where}.agent", f"names agent {command.agent}, outside 0..{n - 1}")
-                wanted = command.action == "remove"
-                if active[command.agent] != wanted:
-                    state = "not flying" if wanted else "already flying"
-                    raise FieldError(f"{where}.agent", f"cannot {command.action} agent {command.agent}: it is {state} then")
-                active[command.agent] = not wanted
-            field = f"{where}.pair" if command.pair is not None else f"{where}.pairs"
-            for i, j in command.targets or []:
-                if not (0 <= i < n and 0 <= j < n):
-                    raise FieldError(field, f"names agent outside 0..{n - 1}: {[i, j]}")
-                if i == j:
-                    raise FieldError(field, f"needs two different agents, got {[i, j]}")
-                if (min(i, j), max(i, j)) not in pairs:
-                    raise FieldError(field, f"{[i, j]} is not a formation pair")
 
     def to_toml(self) -> str:
         """The scenario as TOML text, every default written out."""

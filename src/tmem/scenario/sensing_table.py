@@ -133,7 +133,7 @@ def check_sensing(scenario: Scenario, n_agents: int, uses_lists: bool, limit: in
     uses_lists : bool
         Whether the run finds neighbours with lists (:meth:`NeighborParams.uses_lists`).
     limit : int
-        Most bytes a run may need (:func:`tmem.scenario.schema.memory_limit`).
+        Most bytes a run may need (:func:`tmem.scenario.budget.memory_limit`).
     """
     sensing = scenario.sensing
     if sensing is None or sensing.exact:

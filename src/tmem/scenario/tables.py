@@ -1,16 +1,20 @@
-"""The tables of a scenario file, one validated pydantic model each, and their number types.
+"""The tables of a scenario file: their base class, number types and errors, and the tables of the
+vehicle and its law, one validated pydantic model each.
 
 ``[model]`` (Table 1), ``[controller]`` (roots (5)), ``[interaction]`` (7)-(11),
-``[simulation]``, ``[space]``, ``[neighbors]``, ``[formation]``, ``[swarm]``,
-``[thermostat]``, ``[coverage]``, ``[[obstacles]]``, ``[[agents]]`` (Table 2) and ``[[commands]]``
-(``[sensing]`` has a module of its own, :mod:`tmem.scenario.sensing_table`).  Each table checks its own keys;
-:mod:`tmem.scenario.schema` checks them against each other.  A check that
-spans fields raises :class:`FieldError` naming the field at fault.
+``[simulation]`` and ``[neighbors]`` are here.  The others have modules of their own:
+:mod:`tmem.scenario.agents_table` (``[[agents]]``, Table 2, and ``[swarm]``),
+:mod:`tmem.scenario.space_table` (``[space]``, ``[[obstacles]]``, ``[coverage]``,
+``[thermostat]``), :mod:`tmem.scenario.formation_table`, :mod:`tmem.scenario.commands_table`,
+:mod:`tmem.scenario.sensing_table` and :mod:`tmem.scenario.wind_table`; the classes of the
+first four are importable from here too.  Each table checks its own keys; :mod:`tmem.scenario.schema` checks
+them against each other.  A check that spans fields raises :class:`FieldError` naming the field
+at fault.
 """
 
 from __future__ import annotations
 
-import re
+import importlib
 from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
@@ -248,55 +252,6 @@ class SimulationParams(StrictModel):
         return self
 
 
-class SpaceParams(StrictModel):
-    """The space the agents fly in: 1 to 3 axes, optionally a box from 0 to ``box`` on each axis,
-    periodic or walled.  ``wall_radius``: ``R_w``, a wall or obstacle pushes an agent whose ``P*`` is
-    within ``R + R_w`` of it (default ``R``)."""
-
-    axes: Literal[1, 2, 3] = 1
-    periodic: bool = False
-    walls: bool = False
-    wall_radius: Positive | None = None
-    box: list[Positive] | None = None
-
-    @model_validator(mode="after")
-    def _box_fits(self) -> "SpaceParams":
-        if self.box is not None and len(self.box) != self.axes:
-            raise FieldError("box", per_axis(self.axes, len(self.box)))
-        if self.periodic and self.box is None:
-            raise FieldError("box", "is required when periodic = true")
-        if self.walls and self.box is None:
-            raise FieldError("box", "is required when walls = true")
-        if self.walls and self.periodic:
-            raise FieldError("walls", "a box is periodic or walled, not both")
-        return self
-
-
-class Obstacle(StrictModel):
-    """A circle (a sphere in 3-D, an interval in 1-D) the agents keep off: a neighbour held still."""
-
-    center: Annotated[list[Number], Field(min_length=1, max_length=3)]
-    radius: Positive
-
-
-class CoverageParams(StrictModel):
-    """How the coverage of a walled box is measured (:mod:`tmem.coverage`): square cells of side
-    ``cell`` (m; default ``R``), each visited when an agent passes within ``sensor_radius`` (m) of its
-    centre (0: when it passes through the cell)."""
-
-    cell: Positive | None = None
-    sensor_radius: NonNegative = 0.0
-
-
-class ThermostatParams(StrictModel):
-    """The swarm's temperature as an operator's set-point: its RMS velocity ``rms_velocity`` (m/s;
-    none: the thermostat waits for a ``temperature`` command), reached with time constant ``tau`` (s)
-    (:mod:`tmem.engine.gas`)."""
-
-    rms_velocity: Positive | None = None
-    tau: Annotated[float, Field(gt=0, le=LIMIT)] = 5.0
-
-
 #: Swarms at least this large find their neighbours with Verlet lists under ``method = "auto"``.
 LARGE_SWARM = 64
 
@@ -318,117 +273,19 @@ class NeighborParams(StrictModel):
         return self.method == "verlet" or (self.method == "auto" and n_agents >= LARGE_SWARM)
 
 
-class FormationParams(StrictModel):
-    """A formation: a generated shape, or edges among the ``[[agents]]``."""
 
-    kind: Literal["chain", "ring", "triangle", "hex", "edges"]
-    n: Annotated[int, Field(ge=2)] | None = None
-    d_t: Positive | None = None
-    bearing: bool = False
-    edges: list[Annotated[list[int | float], Field(min_length=2, max_length=3)]] | None = None
-    center: list[Number] | None = None
-    velocity: list[Number] | None = None
-    jitter: NonNegative = 0.0
-    seed: Annotated[int, Field(ge=0)] = 0
-    coupled: bool = True
-
-    @model_validator(mode="after")
-    def _kind_needs(self) -> "FormationParams":
-        if self.kind == "edges":
-            if not self.edges:
-                raise FieldError("edges", 'is required (and not empty) for kind = "edges"')
-            for name in ("n", "center", "velocity"):
-                if getattr(self, name) is not None:
-                    raise FieldError(name, 'is not used with kind = "edges": give the [[agents]]')
-        else:
-            if self.edges is not None:
-                raise FieldError("edges", f'is only for kind = "edges", not {self.kind!r}')
-            if self.kind == "triangle" and self.n not in (None, 3):
-                raise FieldError("n", f"a triangle has 3 agents, got {self.n}")
-            if self.kind in ("chain", "ring", "hex") and self.n is None:
-                raise FieldError("n", f"is required for kind = {self.kind!r}")
-            if self.kind == "ring" and self.n is not None and self.n < 3:
-                raise FieldError("n", f"a ring needs at least 3 agents, got {self.n}")
-        return self
+#: The tables with modules of their own, importable from here as before they had them.  Looked up on
+#: first use (:func:`__getattr__`): their modules build on the base class and number types above.
+_MOVED = {
+    "AGENT_NAME": "agents_table", "Agent": "agents_table", "SwarmParams": "agents_table", "Vector": "agents_table",
+    "Command": "commands_table",
+    "FormationParams": "formation_table",
+    "CoverageParams": "space_table", "Obstacle": "space_table", "SpaceParams": "space_table",
+    "ThermostatParams": "space_table",
+}  # fmt: skip
 
 
-class SwarmParams(StrictModel):
-    """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``."""
-
-    n: Annotated[int, Field(ge=2)]
-    seed: Annotated[int, Field(ge=0)] = 0
-    region: list[Positive] | None = None
-    speed_rms: NonNegative = 0.0
-
-
-Vector = Number | list[Number]
-#: What an agent's name may hold: a robot's name, as ROS writes them (it names the agent's trajectory).
-AGENT_NAME = re.compile(r"[A-Za-z0-9_.-]{1,64}")
-
-
-class Agent(StrictModel):
-    """Initial state of one agent (Table 2): a number per axis, or one number on one axis; its
-    ``name`` (a robot's, say) names its trajectory in the run's files."""
-
-    name: str | None = None
-    position: Vector
-    velocity: Vector = 0.0
-    tilt: Vector = 0.0
-    tilt_rate: Vector = 0.0
-    active: bool = True
-
-    @field_validator("name")
-    @classmethod
-    def _a_robot_name(cls, v: str | None) -> str | None:
-        if v is not None and not AGENT_NAME.fullmatch(v):
-            raise ValueError(f"must be 1 to 64 letters, digits, '_', '.' or '-' (a robot's name), got {v!r}")
-        return v
-
-
-class Command(StrictModel):
-    """An operator's command at ``time``.
-
-    ``couple`` / ``uncouple`` act on ``pair``, on the listed ``pairs``, or on
-    every formation pair when neither is given; ``remove`` / ``add`` act on
-    ``agent``; ``temperature`` sets the thermostat's RMS velocity to ``value`` (m/s).
-    """
-
-    time: NonNegative
-    action: Literal["couple", "uncouple", "remove", "add", "temperature"]
-    pair: Pair | None = None
-    pairs: list[Pair] | None = None
-    agent: int | None = None
-    value: Positive | None = None
-
-    @model_validator(mode="after")
-    def _targets(self) -> "Command":
-        if (self.value is None) == (self.action == "temperature"):
-            raise FieldError("value", "is required for temperature" if self.value is None else f"is for temperature, not {self.action}")
-        if self.action == "temperature":
-            if self.agent is not None or self.pair is not None or self.pairs is not None:
-                raise FieldError("agent" if self.agent is not None else "pair", "a temperature command acts on the whole swarm")
-        elif self.action in ("couple", "uncouple"):
-            if self.agent is not None:
-                raise FieldError("agent", f"is for remove / add, not {self.action}; use pair or pairs")
-            if self.pair is not None and self.pairs is not None:
-                raise FieldError("pairs", "give pair or pairs, not both")
-            if self.pairs is not None and not self.pairs:
-                raise FieldError("pairs", "is empty: leave it out to act on every formation pair, or list at least one")
-            seen: set[tuple[int, int]] = set()
-            for k, (i, j) in enumerate(self.pairs or []):
-                if (min(i, j), max(i, j)) in seen:
-                    raise FieldError(f"pairs[{k}]", f"names the pair {sorted((i, j))} a second time")
-                seen.add((min(i, j), max(i, j)))
-        else:
-            if self.agent is None:
-                raise FieldError("agent", f"is required for {self.action}")
-            if self.pair is not None or self.pairs is not None:
-                raise FieldError("pair", f"is for couple / uncouple, not {self.action}")
-        return self
-
-    @property
-    def targets(self) -> list[list[int]] | None:
-        """The pairs a couple / uncouple command names; ``None`` for every pair."""
-        if self.pair is not None:
-            return [self.pair]
-        return self.pairs
+def __getattr__(name: str) -> object:
+    if name in _MOVED:
+        return getattr(importlib.import_module(f"{__package__}.{_MOVED[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

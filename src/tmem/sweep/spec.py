@@ -94,7 +94,7 @@ _GAS_KEYS = (
 )
 _COVERAGE_KEYS = "share_final|time_to_50|time_to_90"
 #: Nested figures of ``summary.json`` by dotted path: per formation, per pair (by its index), of the
-#: gas (:func:`tmem.observables.gas_summary`) and of the coverage (:func:`tmem.coverage.coverage_summary`).
+#: gas (:func:`tmem.observables.gas_summary`) and of the coverage (:func:`~tmem.coverage.runs.coverage_summary`).
 NESTED_METRIC = re.compile(
     rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})|gas\.({_GAS_KEYS})|coverage\.({_COVERAGE_KEYS})"
 )
