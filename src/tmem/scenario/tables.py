@@ -6,15 +6,14 @@ vehicle and its law, one validated pydantic model each.
 :mod:`tmem.scenario.agents_table` (``[[agents]]``, Table 2, and ``[swarm]``),
 :mod:`tmem.scenario.space_table` (``[space]``, ``[[obstacles]]``, ``[coverage]``,
 ``[thermostat]``), :mod:`tmem.scenario.formation_table`, :mod:`tmem.scenario.commands_table`,
-:mod:`tmem.scenario.sensing_table` and :mod:`tmem.scenario.wind_table`; the classes of the
-first four are importable from here too.  Each table checks its own keys; :mod:`tmem.scenario.schema` checks
-them against each other.  A check that spans fields raises :class:`FieldError` naming the field
+:mod:`tmem.scenario.sensing_table` and :mod:`tmem.scenario.wind_table`; every table is importable
+from :mod:`tmem.scenario`.  Each table checks its own keys; :mod:`tmem.scenario.schema` checks them
+against each other.  A check that spans fields raises :class:`FieldError` naming the field
 at fault.
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
@@ -271,21 +270,3 @@ class NeighborParams(StrictModel):
             The number of agents.
         """
         return self.method == "verlet" or (self.method == "auto" and n_agents >= LARGE_SWARM)
-
-
-
-#: The tables with modules of their own, importable from here as before they had them.  Looked up on
-#: first use (:func:`__getattr__`): their modules build on the base class and number types above.
-_MOVED = {
-    "AGENT_NAME": "agents_table", "Agent": "agents_table", "SwarmParams": "agents_table", "Vector": "agents_table",
-    "Command": "commands_table",
-    "FormationParams": "formation_table",
-    "CoverageParams": "space_table", "Obstacle": "space_table", "SpaceParams": "space_table",
-    "ThermostatParams": "space_table",
-}  # fmt: skip
-
-
-def __getattr__(name: str) -> object:
-    if name in _MOVED:
-        return getattr(importlib.import_module(f"{__package__}.{_MOVED[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
