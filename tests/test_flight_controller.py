@@ -1,14 +1,17 @@
 """The acceleration inner loop (tmem.model.flight_controller): its reference against the closed form of (1),
-its linearisation at hover against the paper's (2), and the airframe flying (2)'s trajectory."""
+its linearisation at hover against the paper's (2), the airframe flying (2)'s trajectory, and (slow) Fig. 9 and the hex.
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.linalg import expm
 
+import tmem
+from tmem.metrics import formation_summary, summarize
 from tmem.model.flight_controller import acceleration_setpoints, advance_reference
 from tmem.model.linear import state_matrices
 from tmem.model.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, flight_commands, rate_loop, step_quadrotor
@@ -122,3 +125,22 @@ def test_the_crazyflie_flies_the_trajectory_of_model_2():
         assert abs(x[0, axis, 1] - exact[1]) < 0.003, (x[0, axis, 1], exact[1])
         np.testing.assert_allclose(body[0, REFERENCE + 2 * axis : REFERENCE + 2 * axis + 2], exact[2:4], atol=1e-9)
     assert abs(body[0, 0]) < 0.01  # the height held
+
+
+EXAMPLES = Path(__file__).parent.parent / "examples"
+
+
+@pytest.mark.slow
+def test_fig9_on_the_crazyflie_gains_what_it_gains_on_model_2():
+    linear = summarize(tmem.simulate(tmem.load(EXAMPLES / "fig9.toml")))
+    flown = summarize(tmem.simulate(tmem.load(EXAMPLES / "vehicles" / "fig9.toml")))
+    pair, reference = flown["pairs"][0], linear["pairs"][0]
+    assert abs(pair["coupled_at"] - reference["coupled_at"]) < 0.1
+    assert 29.0 < pair["uncoupled_at"] < 31.0 and pair["separated_at"] is not None
+    assert abs(flown["rms_change_percent"] - linear["rms_change_percent"]) < 0.5
+
+
+@pytest.mark.slow
+def test_the_hex_on_the_crazyflie_keeps_every_edge_within_2_m():
+    error = formation_summary(tmem.simulate(tmem.load(EXAMPLES / "vehicles" / "hex19.toml")))["distance_error"]
+    assert error["max"] < 2.0
