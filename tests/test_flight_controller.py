@@ -1,5 +1,5 @@
 """The acceleration inner loop (tmem.model.flight_controller): its reference against the closed form of (1),
-its linearisation at hover against the paper's (2), the airframe flying (2)'s trajectory, and (slow) Fig. 9 and the hex.
+its linearisation at hover against the paper's (2), the airframe flying (2)'s trajectory, and (slow) Fig. 9 and the hex."""
 
 from __future__ import annotations
 
