@@ -16,7 +16,7 @@ from tmem.model.flight_controller import acceleration_setpoints, advance_referen
 from tmem.model.linear import state_matrices
 from tmem.model.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, flight_commands, rate_loop, step_quadrotor
 from tmem.model.rigid_body import derivative
-from tmem.scenario import QuadrotorModelParams
+from tmem.scenario import QuadrotorModelParams, WindParams
 
 CALM = (0.0, 0.0, 0.0)
 
@@ -108,8 +108,10 @@ def test_with_the_crazyflies_drag_the_law_reads_model_2_through_the_drags_tilt(a
     assert c_h > 0.2  # the drag is there to be cancelled
 
 
-def test_the_crazyflie_flies_the_trajectory_of_model_2():
-    model = quadrotor()
+@pytest.mark.parametrize("wind", [None, [2.0, -1.0]], ids=["calm", "in a constant wind"])
+def test_the_crazyflie_flies_the_trajectory_of_model_2(wind):
+    params = QuadrotorModelParams(kind="quadrotor", inner_loop="acceleration")
+    model = QuadrotorModel(params) if wind is None else QuadrotorModel(params, WindParams(velocity=wind))
     a2, b2 = state_matrices(6.0, 25.0, 9.81)
     x = np.zeros((1, 2, 4))
     x[0, :, 1] = (3.0, -1.5)

@@ -126,7 +126,7 @@ def acceleration_setpoints(s, ref, ux, uy, params, wind):
     return phi_x, phi_y
 
 
-def initial_reference(s: tuple, tilts: tuple[float, float], rates: tuple[float, float], frame, g: float) -> np.ndarray:
+def initial_reference(s: tuple, tilts: tuple[float, float], rates: tuple[float, float], frame, g: float, wind: tuple) -> np.ndarray:
     """The reference (Q9) of an airframe starting in ``s``: the tilt whose (Q10) is the airframe's.
 
     ``tan(phi_a) = (g phi_r,a - D_a / m) / g`` gives ``phi_r,a = tan(phi_a) + D_a / (m g)``, and
@@ -142,9 +142,11 @@ def initial_reference(s: tuple, tilts: tuple[float, float], rates: tuple[float, 
     frame : Airframe
     g : float
         Gravity (m/s^2).
+    wind : tuple of 3 float
+        The wind of the first step (m/s, world frame).
     """
     r = rotation(s[6], s[7], s[8], s[9])
-    _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, (0.0, 0.0, 0.0))
+    _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, wind)
     c = frame.k_d * sum(s[13:17]) / frame.mass
     drag = ((r[0] * ax + r[1] * ay + r[2] * az) / frame.mass, (r[3] * ax + r[4] * ay + r[5] * az) / frame.mass)
     phi = [math.tan(t) + d / g for t, d in zip(tilts, drag)]

@@ -420,8 +420,8 @@ class QuadrotorModel(VehicleModel):
         The attitude has each axis's tilt (:func:`attitude_of_tilts`), the body rates give each
         axis's tilt rate (:func:`axis_view` inverted) with no yaw rate; the gusts are each agent's
         first (:func:`tmem.model.wind.initial_gusts`: ``state`` in the scenario's order of agents);
-        the acceleration loop's reference is the one whose thrust's tilt is the airframe's
-        (:func:`~tmem.model.flight_controller.initial_reference`).
+        the acceleration loop's reference is the one whose thrust's tilt is the airframe's, in the
+        wind of its first step (:func:`~tmem.model.flight_controller.initial_reference`).
 
         Parameters
         ----------
@@ -442,8 +442,11 @@ class QuadrotorModel(VehicleModel):
             body[i, 9:GUSTS] = math.sqrt(frame.mass * frame.g / (4.0 * frame.k_eta * b3z))
         body[:, GUSTS:REFERENCE] = initial_gusts(self.wind, len(state))
         if self.params.inner_loop == "acceleration":
+            params = self.step_params(self.params.inner_period)
             for i, agent in enumerate(state):
-                s = (agent[0, 0], 0.0, 0.0, agent[0, 1], agent[1, 1] if len(agent) > 1 else 0.0, 0.0, *body[i, 2:GUSTS])
-                tilts, rates = (agent[:, 2], agent[:, 3]) if len(agent) > 1 else ((agent[0, 2], 0.0), (agent[0, 3], 0.0))
-                body[i, REFERENCE:] = initial_reference(s, tuple(tilts), tuple(rates), frame, frame.g)
+                two = len(agent) > 1
+                s = (agent[0, 0], 0.0, 0.0, agent[0, 1], agent[1, 1] if two else 0.0, 0.0, *body[i, 2:GUSTS])
+                tilts, rates = (agent[:, 2], agent[:, 3]) if two else ((agent[0, 2], 0.0), (agent[0, 3], 0.0))
+                wind = wind_now(body, i, GUSTS, params, two)
+                body[i, REFERENCE:] = initial_reference(s, tuple(tilts), tuple(rates), frame, frame.g, wind)
         return body
