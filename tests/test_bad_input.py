@@ -75,6 +75,8 @@ CASES = {
     "quadrotor inner loop too slow": (quadrotor("inner_period = 0.05"), "model.inner_period", "too long for the rate loop"),
     "quadrotor drag negative": (quadrotor("rotor_drag = -1.0"), "model.rotor_drag", "greater than or equal to 0"),
     "quadrotor typo": (quadrotor("mas = 0.03"), "model.mas", "unknown key"),
+    "quadrotor drag left to the acceleration loop": (quadrotor("drag_feedforward = false"), "model.drag_feedforward", "tilt loop's"),
+    "quadrotor unknown inner loop": (quadrotor('inner_loop = "rate"'), "model.inner_loop", "acceleration"),
 }
 
 

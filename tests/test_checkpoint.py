@@ -26,6 +26,7 @@ from tmem.cli import app
 from tmem.engine import checkpoint as ckpt
 from tmem.engine import records
 from tmem.engine.checkpoint import CheckpointError, Checkpoints, checkpoint_path
+from tmem.model.quadrotor import BODY_NAMES
 from tmem.scenario import from_dict, with_changes
 
 from test_interruptions import Command, partials  # starts `python -m tmem`, waits for a moment
@@ -127,7 +128,7 @@ CASES = {
     "gas box": (gas_box, 1.0, 3.0, lambda saved, run: saved.arrays["gas.target2"][0] == 9.0),  # the command's, not 4
     "hex19": (hex19, 2.0, 4.0, lambda saved, run: saved.arrays["agents.active"].sum() == 18),  # agent 3 lost
     "quadrotor hex19": (quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.any(saved.arrays["agents.body"] != saved.arrays["agents.body_start"])),
-    "turbulent quadrotor hex19": (turbulent_quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.all(saved.arrays["agents.body"][:, -1] > 0)),
+    "turbulent quadrotor hex19": (turbulent_quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.all(saved.arrays["agents.body"][:, BODY_NAMES.index("gust_step")] > 0)),
     "sensed fig9": (sensed_fig9, 2.0, 6.0, lambda saved, run: np.any(saved.arrays["sensing.history"] != 0.0)),
 }
 

@@ -40,7 +40,8 @@ CALM = (0.0, 0.0, 0.0)
 
 
 def quadrotor(**changes) -> QuadrotorModel:
-    return QuadrotorModel(QuadrotorModelParams(kind="quadrotor", **changes))
+    """The tilt loop (Q5)-(Q8), whose commands RotorPy is fed (tests/test_flight_controller.py: the acceleration loop)."""
+    return QuadrotorModel(QuadrotorModelParams(kind="quadrotor", inner_loop="tilt", **changes))
 
 
 def packed(x: np.ndarray, body: np.ndarray) -> tuple:

@@ -6,8 +6,8 @@ Two parts::
     python docs/scripts/survive.py sweeps out      # tables and figures from the sweeps written under out/
 
 ``reruns`` flies the paper's Figs. 5, 7 and 9, the formation flights of docs/swarms.md and the gas
-of examples/swarm/gas2d.toml on the linear model (2) and on the quadrotor, and prints one Markdown
-table.  ``sweeps`` reads the ``results.parquet`` of the three sensing sweeps of
+of examples/swarm/gas2d.toml on the linear model (2) and on the quadrotor under each inner loop (the
+tilt loop's runs started level, as the sweeps fly it), and prints one Markdown table.  ``sweeps`` reads the ``results.parquet`` of the three sensing sweeps of
 examples/sweeps/vehicles_*.toml (run with ``tmem sweep FILE --out out/vehicles_NAME``), prints their
 tables and draws docs/images/vehicles-*.png, with the linear model's and the exact quadrotor's
 values, flown here, as reference lines.  docs/scripts/survive_wind.py does the same for the two wind
@@ -46,6 +46,16 @@ def on_quadrotor(scenario: Scenario) -> Scenario:
     data = scenario.model_dump(mode="json", exclude_none=True)
     data["model"] = {"kind": "quadrotor"}
     data["simulation"]["dt"] = max(data["simulation"]["dt"], SWARM_DT)
+    return from_dict(data)
+
+
+def tilt_loop(scenario: Scenario) -> Scenario:
+    """The quadrotor ``scenario`` under the tilt loop, its ``[[agents]]`` started level: the quadrotor
+    of the sensing and wind sweeps (docs/vehicles.md)."""
+    data = scenario.model_dump(mode="json", exclude_none=True)
+    data["model"]["inner_loop"] = "tilt"
+    for agent in data.get("agents") or []:
+        agent["tilt"] = 0.0
     return from_dict(data)
 
 
@@ -116,14 +126,15 @@ def reruns() -> list[tuple[str, str, Scenario, Scenario, object]]:
 
 def print_reruns(names: list[str]) -> None:
     """The reruns' table; only the runs whose names start with one of ``names``, if any are given."""
-    print("| run | paper | figure of merit | linear (2) | quadrotor |")
-    print("| --- | --- | --- | --- | --- |")
+    print("| run | paper | figure of merit | linear (2) | quadrotor, tilt loop | quadrotor, acceleration loop |")
+    print("| --- | --- | --- | --- | --- | --- |")
     for name, paper, linear, quad, figures in reruns():
         if names and not any(name.startswith(n) for n in names):
             continue
-        ours, theirs = figures(tmem.simulate(linear)), figures(tmem.simulate(quad))
+        ours, tilt, theirs = (figures(tmem.simulate(s)) for s in (linear, tilt_loop(quad), quad))
         for k, key in enumerate(ours):
-            print(f"| {name if k == 0 else ''} | {paper if k == 0 else ''} | {key} | {ours[key]} | {theirs[key]} |", flush=True)
+            print(f"| {name if k == 0 else ''} | {paper if k == 0 else ''} | {key} | {ours[key]} | {tilt[key]} | {theirs[key]} |",
+                  flush=True)  # fmt: skip
 
 
 #: The swept quantities of the one-at-a-time sweeps: (column, label, scale; ``None`` for named levels).

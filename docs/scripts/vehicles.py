@@ -60,7 +60,7 @@ def with_lag(model: QuadrotorModel, gains: np.ndarray, tau: float) -> np.ndarray
 
 
 def linearisation() -> None:
-    model = QuadrotorModel(QuadrotorModelParams(kind="quadrotor"))
+    model = QuadrotorModel(QuadrotorModelParams(kind="quadrotor", inner_loop="tilt"))
     a, b = model.linearisation()
     numerical, numerical_b = manoeuvres.numerical_linearisation(model, 0)
     print(f"A at hover (Crazyflie, feed-forward on):\n{np.array2string(a, precision=4, suppress_small=True)}")
@@ -70,6 +70,11 @@ def linearisation() -> None:
     print(f"K = {np.array2string(gains, precision=5)}; roots of A - B K: {np.round(np.linalg.eigvals(a - np.outer(b, gains)), 4)}")
     for tau in (0.072, 0.03, 0.01):
         print(f"with the motors' lag tau_m = {tau} s: {np.round(with_lag(model, gains, tau), 3)}")
+    model = QuadrotorModel(QuadrotorModelParams(kind="quadrotor", inner_loop="acceleration"))
+    a, b = model.linearisation()
+    gains = gains_for(a, b, 12.0, 0.1, 0.55)
+    print(f"acceleration loop: A =\n{np.array2string(a, precision=4, suppress_small=True)}\nB = {b}")
+    print(f"K = {np.array2string(gains, precision=5)}; roots of A - B K: {np.round(np.linalg.eigvals(a - np.outer(b, gains)), 4)}")
 
 
 def changed(scenario, **tables):
@@ -79,25 +84,33 @@ def changed(scenario, **tables):
     return from_dict(data)
 
 
-def trimmed(scenario):
-    """``scenario`` with each agent starting at the tilt that balances its drag at its speed (Q8)."""
+def trimmed(scenario, trim: bool = True):
+    """``scenario`` with each agent starting at the tilt that balances its drag at its speed (Q8),
+    or level (``trim`` false)."""
     a, _ = QuadrotorModel(scenario.model).linearisation()
     data = scenario.model_dump(mode="json", exclude_none=True)
     for agent in data["agents"]:
-        agent["tilt"] = float(np.arctan(-a[1, 1] * agent["velocity"] / scenario.model.g))
+        agent["tilt"] = float(np.arctan(-a[1, 1] * agent["velocity"] / scenario.model.g)) if trim else 0.0
     return from_dict(data)
 
 
 def fig9() -> None:
     linear = load(ROOT / "examples" / "fig9.toml")
-    quad = load(ROOT / "examples" / "vehicles" / "fig9.toml")
+    quad = load(ROOT / "examples" / "vehicles" / "fig9.toml")  # the acceleration loop, started trimmed
+    level = trimmed(quad, trim=False)
+    tilt = changed(level, model={"inner_loop": "tilt"})
+    no_drag = {"rotor_drag": 0.0, "inflow_drag": 0.0}
     runs = {
         "linear (2)": linear,
-        "quadrotor": quad,
-        "quadrotor, no drag feed-forward": changed(quad, model={"drag_feedforward": False}),
-        "quadrotor, no drag": changed(quad, model={"rotor_drag": 0.0, "inflow_drag": 0.0}),
-        "quadrotor, motors' lag 10 ms": changed(quad, model={"tau_m": 0.01}),
-        "quadrotor, started trimmed": trimmed(quad),
+        "tilt loop": tilt,
+        "tilt loop, no drag feed-forward": changed(tilt, model={"drag_feedforward": False}),
+        "tilt loop, no rotor drag": changed(tilt, model=no_drag),
+        "tilt loop, motors' lag 10 ms": changed(tilt, model={"tau_m": 0.01}),
+        "tilt loop, started trimmed": trimmed(tilt),
+        "acceleration loop, started trimmed (examples/vehicles/fig9.toml)": quad,
+        "acceleration loop, started level": level,
+        "acceleration loop, no rotor drag": changed(level, model=no_drag),
+        "acceleration loop, motors' lag 10 ms": changed(quad, model={"tau_m": 0.01}),
     }
     print("| vehicle | couples at (s) | uncouples at (s) | apart at (s) | RMS change (%) | largest height error (m) |")
     print("| --- | --- | --- | --- | --- | --- |")
@@ -114,7 +127,9 @@ def hex19() -> None:
     quad = load(ROOT / "examples" / "vehicles" / "hex19.toml")
     linear = load(ROOT / "examples" / "swarm" / "hex19.toml")
     linear_1ms = quad.model_dump(mode="json", exclude_none=True) | {"model": {"kind": "linear"}}
-    runs = {"linear (2), dt = 0.1 ms": linear, "linear (2), dt = 1 ms": from_dict(linear_1ms), "quadrotor, dt = 1 ms": quad}
+    runs = {"linear (2), dt = 0.1 ms": linear, "linear (2), dt = 1 ms": from_dict(linear_1ms),
+            "quadrotor, tilt loop, dt = 1 ms": changed(quad, model={"inner_loop": "tilt"}),
+            "quadrotor, acceleration loop, dt = 1 ms": quad}  # fmt: skip
     print("| vehicle | largest edge error (m) | RMS edge error (m) | RMS change (%) | largest height error (m) |")
     print("| --- | --- | --- | --- | --- |")
     for name, scenario in runs.items():

@@ -38,6 +38,12 @@ a digital one does) and turns the set-points into what the vehicle takes:
 
       phi_d = U + phi_ff                                           (Q8)
 
+That is the *tilt loop* (``[model] inner_loop = "tilt"``).  The default, the
+*acceleration loop* of :mod:`tmem.model.flight_controller`, feeds (Q5)-(Q7) the
+tilt set-points (Q9)-(Q11) instead: those that give the airframe the
+horizontal acceleration of the paper's linear agent (2), its drag cancelled;
+(Q8) is not used.
+
 The sub-step ``h`` is the longest that divides ``dt`` into whole steps and is
 at most ``inner_period``; RK4 integrates (Q1)-(Q4) over each sub-step, and the
 quaternion is normalised after it, as RotorPy does after each of its steps.
@@ -46,7 +52,9 @@ State layout.  The engine keeps each axis's ``(P, V, phi, omega)`` (the TMEM
 law reads them) in ``state[i, a, :]`` and the rest of the body in the
 per-agent body state ``body[i, :]`` (:data:`BODY_NAMES`).  ``P`` and ``V`` are
 the body's own horizontal position and velocity; ``phi`` and ``omega`` are
-written from its attitude and body rates after each step.  A 1-D run flies in
+written from its attitude and body rates after each step: the airframe's own tilt and its
+rate, under either loop (the acceleration loop's reference (Q9), the linear agent's tilt, is
+kept in the body state).  A 1-D run flies in
 the vertical x-z plane: the lateral position and velocity are zero by
 symmetry, and not kept.  A 3-D run is refused: the vertical axis is the
 altitude hold's.
@@ -62,12 +70,16 @@ import numpy as np
 
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from .base import VehicleModel
-from .linear import STATE_NAMES
+from .flight_controller import (REFERENCE_FIELDS, REFERENCE_LONG_NAMES, REFERENCE_NAMES, REFERENCE_UNITS, acceleration_setpoints,
+                                advance_reference, initial_reference, reference_hold, reported_coordinates)
+from .linear import STATE_NAMES, state_matrices
 from .rigid_body import Airframe, derivative, hover_speed, rotation, rotor_commands, wrench
 from .wind import GUST_LONG_NAMES, GUST_NAMES, GUST_UNITS, WIND_FIELDS, advance_gusts, initial_gusts, wind_fields, wind_now
 
 #: The per-agent body state, after the per-axis ``(P, V, phi, omega)``: the rigid body's, then the
-#: gusts of :mod:`tmem.model.wind` from column :data:`GUSTS` (zeros without turbulence).
+#: gusts of :mod:`tmem.model.wind` from column :data:`GUSTS` (zeros without turbulence), then, with
+#: the acceleration loop only, its reference (Q9) from column :data:`REFERENCE`
+#: (:data:`ACCELERATION_BODY_NAMES`).
 RIGID_BODY_NAMES = ("height", "v_z", "q_x", "q_y", "q_z", "q_w", "w_x", "w_y", "w_z", "rotor_1", "rotor_2", "rotor_3", "rotor_4")
 GUSTS = len(RIGID_BODY_NAMES)
 BODY_NAMES = RIGID_BODY_NAMES + GUST_NAMES
@@ -79,18 +91,23 @@ BODY_LONG_NAMES = (
     "body rate about x", "body rate about y", "body rate about z",
     "speed of rotor 1", "speed of rotor 2", "speed of rotor 3", "speed of rotor 4", *GUST_LONG_NAMES,
 )  # fmt: skip
+#: The first column of the acceleration loop's reference (Q9), after the gusts.
+REFERENCE = len(BODY_NAMES)
+ACCELERATION_BODY_NAMES = BODY_NAMES + REFERENCE_NAMES
 
 
 #: What one step of ``dt`` needs: the airframe's numbers (:class:`~tmem.model.rigid_body.Airframe`'s
 #: fields, so that the record serves as the airframe), then the inner loop's gains ``kp``, ``kd``
 #: (Q5)-(Q6) (1/s) and ``altitude_kp``, ``altitude_kd`` (Q7) (1/s^2, 1/s), whether the drag
-#: feed-forward (Q8) is on, the number of sub-steps in ``dt`` and the sub-step ``h`` (s), and the
-#: wind (:data:`tmem.model.wind.WIND_FIELDS`).  One flat record: a parallel loop takes no record
-#: nested in another.
+#: feed-forward (Q8) is on, the number of sub-steps in ``dt`` and the sub-step ``h`` (s), whether
+#: the acceleration loop (Q9)-(Q11) of :mod:`tmem.model.flight_controller` flies (else the tilt
+#: loop), its reference's hold over ``h`` (:data:`~tmem.model.flight_controller.REFERENCE_FIELDS`)
+#: and the wind (:data:`tmem.model.wind.WIND_FIELDS`).  One flat record: a parallel loop takes no
+#: record nested in another.
 QuadrotorStep = NamedTuple(
     "QuadrotorStep",
     [*Airframe.__annotations__.items(), ("kp", float), ("kd", float), ("altitude_kp", float), ("altitude_kd", float),
-     ("feedforward", bool), ("substeps", int), ("h", float), *WIND_FIELDS],
+     ("feedforward", bool), ("substeps", int), ("h", float), ("acceleration", bool), *REFERENCE_FIELDS, *WIND_FIELDS],
 )  # fmt: skip
 
 
@@ -233,12 +250,15 @@ def step_quadrotor(x, body, u, i, scale, params, n_axes):
     """Advance agent ``i`` over one step with the tilt set-points ``U = u[i] * scale`` and the wind held,
     then draw its gusts of the next step (:mod:`tmem.model.wind`).
 
+    With the acceleration loop, each sub-step's tilt set-points are (Q10)-(Q11)'s from the
+    reference (Q9), which advances after it.
+
     Parameters
     ----------
     x : ndarray, shape (agents, axes, 4)
         Per-axis states ``(P, V, phi, omega)``, changed in place.
-    body : ndarray, shape (agents, 20)
-        Body states (:data:`BODY_NAMES`), changed in place.
+    body : ndarray, shape (agents, 20) or (agents, 24)
+        Body states (:data:`BODY_NAMES`, or :data:`ACCELERATION_BODY_NAMES`), changed in place.
     u : ndarray, shape (agents, axes)
         Summed tilt set-points (rad).
     i : int
@@ -256,8 +276,17 @@ def step_quadrotor(x, body, u, i, scale, params, n_axes):
     s = (x[i, 0, 0], x[i, 1, 0] if two else 0.0, b[i, 0], x[i, 0, 1], x[i, 1, 1] if two else 0.0, b[i, 1],
          b[i, 2], b[i, 3], b[i, 4], b[i, 5], b[i, 6], b[i, 7], b[i, 8], b[i, 9], b[i, 10], b[i, 11], b[i, 12])  # fmt: skip
     wind = wind_now(b, i, GUSTS, params, two)
-    for _ in range(params.substeps):
-        s = substep(s, ux, uy, params, wind)
+    if params.acceleration:
+        ref = (b[i, REFERENCE], b[i, REFERENCE + 1], b[i, REFERENCE + 2], b[i, REFERENCE + 3])
+        for _ in range(params.substeps):
+            tilt_x, tilt_y = acceleration_setpoints(s, ref, ux, uy, params, wind)
+            s = substep(s, tilt_x, tilt_y, params, wind)
+            ref = advance_reference(ref, ux, uy, params)
+        for m in range(4):
+            b[i, REFERENCE + m] = ref[m]
+    else:
+        for _ in range(params.substeps):
+            s = substep(s, ux, uy, params, wind)
     x[i, 0, 0], x[i, 0, 1] = s[0], s[3]
     tilt_x, rate_x, tilt_y, rate_y = axis_view(s)
     x[i, 0, 2], x[i, 0, 3] = tilt_x, rate_x
@@ -289,7 +318,8 @@ def attitude_of_tilts(tilt_x: float, tilt_y: float) -> tuple[float, float, float
 
 
 class QuadrotorModel(VehicleModel):
-    """A nonlinear quadrotor (the Crazyflie 2.x by default) under the inner loop (Q5)-(Q8).
+    """A nonlinear quadrotor (the Crazyflie 2.x by default) under its inner loop: the acceleration
+    loop (Q9)-(Q11) with (Q5)-(Q7) (:mod:`tmem.model.flight_controller`), or the tilt loop (Q5)-(Q8).
 
     Parameters
     ----------
@@ -311,6 +341,10 @@ class QuadrotorModel(VehicleModel):
     def __init__(self, params: Any, wind: Any = None):
         super().__init__(params)
         self.wind = wind
+        if params.inner_loop == "acceleration":
+            self.body_names = ACCELERATION_BODY_NAMES
+            self.body_units = BODY_UNITS + REFERENCE_UNITS
+            self.body_long_names = BODY_LONG_NAMES + REFERENCE_LONG_NAMES
 
     def airframe(self) -> Airframe:
         """The rigid body's numbers, from the ``[model]`` table."""
@@ -334,10 +368,25 @@ class QuadrotorModel(VehicleModel):
         Without drag it is (2) exactly.  The y axis has ``I_xx`` for ``I_yy``: the same for a
         symmetric frame (the Crazyflie's).  ``tests/test_quadrotor.py`` checks it against finite
         differences of (Q1)-(Q8).
+
+        That is the tilt loop's.  The acceleration loop (Q9)-(Q11) makes the airframe move as
+        (2), and the law reads (2)'s state in the airframe's coordinates
+        (:func:`~tmem.model.flight_controller.reported_coordinates`): ``(T A_2 T^-1, T B_2)``
+        with ``(A_2, B_2)`` of (2), and ``T B_2 = B_2``::
+
+            A = [[0, 1, 0, 0], [0, -c_h, g, 0], [0, 0, 0, 1], [0, k c_h / g, -k, -kd + c_h]]
+            B = [0, 0, 0, kp kd]^T                (k = kp kd - kd c_h + c_h^2)
+
+        ``tests/test_flight_controller.py`` checks it against finite differences of
+        (Q1)-(Q7), (Q9)-(Q11).
         """
         p, frame = self.params, self.airframe()
         hover = hover_speed(frame)
         c_h = 4.0 * p.rotor_drag * hover / p.mass
+        if p.inner_loop == "acceleration":
+            t = reported_coordinates(c_h, p.g)
+            a2, b2 = state_matrices(p.kp, p.kd, p.g)
+            return t @ a2 @ np.linalg.inv(t), t @ b2
         c_r = 4.0 * p.inflow_drag * hover * frame.offset**2 / p.iyy
         feedforward = p.kp * p.kd * c_h / p.g if p.drag_feedforward else 0.0
         a = np.array(
@@ -360,22 +409,26 @@ class QuadrotorModel(VehicleModel):
         """
         p = self.params
         substeps = max(1, math.ceil(dt / p.inner_period - 1e-9))
-        return QuadrotorStep(*self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward,
-                             substeps, dt / substeps, *wind_fields(self.wind, dt))  # fmt: skip
+        acceleration = p.inner_loop == "acceleration"
+        return QuadrotorStep(*self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward and not acceleration,
+                             substeps, dt / substeps, acceleration, *reference_hold(p.kp, p.kd, dt / substeps),
+                             *wind_fields(self.wind, dt))  # fmt: skip
 
     def initial_body(self, state: np.ndarray) -> np.ndarray:
         """Body states for per-axis states: at height 0, not climbing, yaw 0, rotors carrying the weight.
 
         The attitude has each axis's tilt (:func:`attitude_of_tilts`), the body rates give each
         axis's tilt rate (:func:`axis_view` inverted) with no yaw rate; the gusts are each agent's
-        first (:func:`tmem.model.wind.initial_gusts`: ``state`` in the scenario's order of agents).
+        first (:func:`tmem.model.wind.initial_gusts`: ``state`` in the scenario's order of agents);
+        the acceleration loop's reference is the one whose thrust's tilt is the airframe's, in the
+        wind of its first step (:func:`~tmem.model.flight_controller.initial_reference`).
 
         Parameters
         ----------
         state : ndarray, shape (agents, axes, 4)
         """
         frame = self.airframe()
-        body = np.zeros((state.shape[0], len(BODY_NAMES)))
+        body = np.zeros((state.shape[0], len(self.body_names)))
         for i, agent in enumerate(state):
             tilt_y, rate_y = (agent[1, 2], agent[1, 3]) if len(agent) > 1 else (0.0, 0.0)
             q = attitude_of_tilts(agent[0, 2], tilt_y)
@@ -387,5 +440,13 @@ class QuadrotorModel(VehicleModel):
             body[i, 2:6] = q
             body[i, 6:8] = w
             body[i, 9:GUSTS] = math.sqrt(frame.mass * frame.g / (4.0 * frame.k_eta * b3z))
-        body[:, GUSTS:] = initial_gusts(self.wind, len(state))
+        body[:, GUSTS:REFERENCE] = initial_gusts(self.wind, len(state))
+        if self.params.inner_loop == "acceleration":
+            params = self.step_params(self.params.inner_period)
+            for i, agent in enumerate(state):
+                two = len(agent) > 1
+                s = (agent[0, 0], 0.0, 0.0, agent[0, 1], agent[1, 1] if two else 0.0, 0.0, *body[i, 2:GUSTS])
+                tilts, rates = (agent[:, 2], agent[:, 3]) if two else ((agent[0, 2], 0.0), (agent[0, 3], 0.0))
+                wind = wind_now(body, i, GUSTS, params, two)
+                body[i, REFERENCE:] = initial_reference(s, tuple(tilts), tuple(rates), frame, frame.g, wind)
         return body

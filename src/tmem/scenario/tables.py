@@ -118,6 +118,9 @@ class QuadrotorModelParams(StrictModel):
     altitude_kd: Positive = 8.0
     inner_period: Annotated[float, Field(ge=1e-6, le=1.0)] = 0.002
     drag_feedforward: bool = True
+    #: ``"acceleration"``: the airframe asked for (2)'s acceleration, (Q9)-(Q11); ``"tilt"``: the
+    #: set-point ``U`` to the attitude loop, with the drag feed-forward (Q8) (docs/vehicles.md).
+    inner_loop: Literal["acceleration", "tilt"] = "acceleration"
 
     #: The most axes a run of this model may have: the vertical one is the altitude hold's.
     max_axes: ClassVar[int] = 2
@@ -131,6 +134,9 @@ class QuadrotorModelParams(StrictModel):
         if self.kd * self.inner_period > MAX_RATE_LOOP_STEP:
             raise FieldError("inner_period", f"{self.inner_period:g} s is too long for the rate loop: kd x inner_period = "
                              f"{self.kd * self.inner_period:.3g}, at most {MAX_RATE_LOOP_STEP:g}")  # fmt: skip
+        if not self.drag_feedforward and self.inner_loop == "acceleration":
+            raise FieldError("drag_feedforward", 'false is the tilt loop\'s (inner_loop = "tilt"): the acceleration loop '
+                             "cancels the drag it feels")  # fmt: skip
         return self
 
 
