@@ -159,24 +159,56 @@ def interaction_point(x: np.ndarray, gains: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
-def corrected_position(p, v, phi, omega, gains, agent):
+def gains_of(gains, agent):
+    """Agent ``agent``'s ``K = (K_P, K_V, K_phi, K_omega)`` as four numbers, from its own row or the shared one.
+
+    A loop over agents that share one row takes it once, before the loop, and keeps it in registers.
+
+    Parameters
+    ----------
+    gains : ndarray, shape (agents, 4) or (1, 4)
+        Each agent's ``K`` (:func:`modal_gains`), or one row that every agent shares (no stream of
+        identical rows through the cache); indexed in place, since a row taken out as an array would
+        cost a reference count at every agent.
+    agent : int
+        The agent's row when there is a row per agent.
+    """
+    row = agent if gains.shape[0] > 1 else 0
+    return gains[row, 0], gains[row, 1], gains[row, 2], gains[row, 3]
+
+
+@numba.njit(cache=True, inline="always")
+def corrected_by(p, v, phi, omega, k):
     """``P* = x . K / K_P`` (6) of one axis's state ``x = (p, v, phi, omega)``, in compiled code.
 
-    The same quantity as :func:`interaction_point`, for the step loop and the batch; the sum runs
-    in the order of the state, so every caller gets the same bits.
+    The same quantity as :func:`interaction_point`, for the step loop, the batch and the per-agent
+    controller; the sum runs in the order of the state, so every caller gets the same bits.
+
+    Parameters
+    ----------
+    p, v, phi, omega : float
+        Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
+    k : tuple of 4 float
+        The agent's ``K`` (:func:`gains_of`).
+    """
+    return (p * k[0] + v * k[1] + phi * k[2] + omega * k[3]) / k[0]
+
+
+@numba.njit(cache=True, inline="always")
+def corrected_position(p, v, phi, omega, gains, agent):
+    """``P* = x . K / K_P`` (6) of one axis's state of agent ``agent``: :func:`corrected_by` with
+    :func:`gains_of`.
 
     Parameters
     ----------
     p, v, phi, omega : float
         Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
     gains : ndarray, shape (agents, 4) or (1, 4)
-        Each agent's ``K`` (:func:`modal_gains`), or one row that every agent shares; indexed in
-        place, since a row taken out as an array would cost a reference count at every agent.
+        Each agent's ``K``, or one row that every agent shares.
     agent : int
         The agent's row when there is a row per agent.
     """
-    row = agent if gains.shape[0] > 1 else 0  # one row shared: no stream of identical rows through the cache
-    return (p * gains[row, 0] + v * gains[row, 1] + phi * gains[row, 2] + omega * gains[row, 3]) / gains[row, 0]
+    return corrected_by(p, v, phi, omega, gains_of(gains, agent))
 
 
 @numba.njit(cache=True, inline="always")

@@ -27,7 +27,7 @@ import numba
 import numpy as np
 
 from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
-from ..control import corrected_position, tilt_scale
+from ..control import corrected_by, gains_of, tilt_scale
 from ..interaction.kernels import FunctionParams, push_factor
 from ..space import nearest_image
 from .gas import add_contact, clear, pair_share, record_totals, tilt_limit
@@ -155,7 +155,7 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def corrected_positions(known, agents, law, run, neighbours, gas, listed):
+def corrected_positions(known, agents, law, run, neighbours, gas, listed, observe):
     """``P* = x . K / K_P`` (6) of every agent as it knows itself, and its true ``P``, into
     ``agents.corrected``; clear the set-points (and, when the gas is observed, its counts:
     :func:`tmem.engine.gas.clear`).
@@ -173,9 +173,10 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed):
     listed : int
         What the lists hold: 0, ``P*`` (the exact path), or 1, ``P`` (the sensed path, whose range
         is one of positions).
+    observe : bool
+        ``Gas.observe``, a constant of the compiled loop (:data:`tmem.engine.loop.OBSERVED`).
     """
     box = run.box
-    observe = gas.observe
     work = gas.work
     kept = gas.kept
     c_max = gas.c_max
@@ -191,21 +192,27 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed):
     n_agents = known.shape[0]
     n_blocks = block_shift2.shape[0]
     per_block = (n_agents + n_blocks - 1) // n_blocks
+    per_agent = gains.shape[0] > 1
+    shared = gains_of(gains, 0)
     for b in numba.prange(n_blocks):  # each block's largest shift: a parallel reduction would allocate
-        block_shift2[b] = 0.0
+        largest = 0.0
         for i in range(b * per_block, min(n_agents, (b + 1) * per_block)):
+            k = gains_of(gains, i) if per_agent else shared
             shift2 = 0.0
             for a in range(n_axes):
-                corrected[i, a, 0] = corrected_position(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], gains, i)
-                corrected[i, a, 1] = state[i, a, 0]
+                star = corrected_by(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], k)
+                position = known[i, a, 0] if listed == 0 else state[i, a, 0]  # exact path: known is the state
+                corrected[i, a, 0] = star
+                corrected[i, a, 1] = position
                 setpoint[i, a] = 0.0  # the sum of pushes starts here
                 if use_lists:
-                    delta = nearest_image(corrected[i, a, listed] - p_ref[i, a], box[a])
+                    delta = nearest_image((star if listed == 0 else position) - p_ref[i, a], box[a])
                     shift2 += delta * delta
             if observe:
                 clear(i, known, work, kept, c_max, n_axes)
             if active[i]:
-                block_shift2[b] = max(block_shift2[b], shift2)
+                largest = max(largest, shift2)
+        block_shift2[b] = largest
     moved = 0.0
     for b in range(n_blocks):
         moved = max(moved, block_shift2[b])
