@@ -14,7 +14,8 @@ import tmem
 from tmem.metrics import formation_summary, summarize
 from tmem.model.flight_controller import acceleration_setpoints, advance_reference
 from tmem.model.linear import state_matrices
-from tmem.model.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, flight_commands, rate_loop, step_quadrotor
+from tmem.model.flight_controller import flight_commands, rate_loop
+from tmem.model.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, step_quadrotor
 from tmem.model.rigid_body import derivative
 from tmem.scenario import QuadrotorModelParams, WindParams
 

@@ -15,7 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from tmem.model.quadrotor import GUSTS, QuadrotorModel, axis_view, flight_commands, rate_loop, step_quadrotor
+from tmem.model.flight_controller import flight_commands, rate_loop
+from tmem.model.quadrotor import GUSTS, QuadrotorModel, axis_view, step_quadrotor
 from tmem.model.rigid_body import derivative, hover_speed
 from tmem.model.linear import state_matrices
 from tmem.scenario import QuadrotorModelParams

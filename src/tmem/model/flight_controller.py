@@ -1,8 +1,52 @@
-"""The acceleration inner loop of the quadrotor: the airframe asked to move as the paper's linear agent (2).
+"""The quadrotor's flight controller: its attitude, rate and altitude loops, and the two inner loops that feed them.
 
-``[model] inner_loop = "acceleration"`` (:mod:`tmem.model.quadrotor`).  The TMEM law gives each
-horizontal axis ``a`` its tilt set-point ``U_a``.  The flight controller runs, per axis, the
-paper's attitude model (1) as a reference, the tilt the linear agent would have::
+The TMEM law gives each horizontal axis ``a`` its tilt set-point ``U_a``.  The
+tilt on axis ``a`` is the angle of the thrust axis ``b_3 = R e_3`` from the
+vertical, seen along the other horizontal axis, ``phi_a = atan2(b_3a, b_3z)``.
+The flight controller runs every sub-step ``h`` (zero-order hold, as
+a digital one does) and turns the set-points into what the vehicle takes:
+
+* attitude loop, the paper's (1)::
+
+      omega_d = kp (phi_d - phi)                                   (Q5)
+
+  on each axis, as body rates: ``w_y,d = kp (phi_d,x - phi_x)``,
+  ``w_x,d = -kp (phi_d,y - phi_y)`` (a tilt along +x is a rotation about +y,
+  along +y about -x), and the yaw held at 0 with ``w_z,d = -kp psi``;
+* rate loop, the paper's ``omega' = kd (omega_d - omega)`` on the body rates,
+  realised as moments through the rotors and their lag (RotorPy's ``cmd_ctbr``
+  with ``k_w = kd``)::
+
+      M = J kd (w_d - w)                                           (Q6)
+
+* altitude hold: a collective thrust whose vertical part carries the weight
+  and a PD correction of the height ``z`` (0 at the start)::
+
+      T = m (g - k_zp z - k_zd z') / b_3z                           (Q7)
+
+  so that, height held, the horizontal acceleration on each axis is
+  ``g tan(phi_a)``: with this tilt and ``T b_3z = m g`` it is exactly
+  ``(T / m) b_3a = g b_3a / b_3z``, on each axis apart, and to first order it
+  is (2)'s ``g phi``.  (Holding the thrust at ``m g`` instead would give
+  ``g sin``, and the vehicle would sink as it tilts.)
+* drag feed-forward (``drag_feedforward``): the frame's and rotors' drag
+  slows a quadrotor in free flight (the Crazyflie's rotor drag alone, by
+  ``c_h = 4 k_d o_h / m = 0.24 /s``), where (2)'s agent keeps its speed.  The
+  controller adds the tilt that balances the drag it would feel now,
+  ``phi_ff,a = atan(-D_a / (m g))`` with ``D_a`` the aerodynamic force on axis
+  ``a`` (world frame), to the set-point::
+
+      phi_d = U + phi_ff                                           (Q8)
+
+That is the *tilt loop* (``[model] inner_loop = "tilt"``).  The default, the
+*acceleration loop*, feeds (Q5)-(Q7) the tilt set-points (Q9)-(Q11) instead:
+those that give the airframe the horizontal acceleration of the paper's linear
+agent (2), its drag cancelled; (Q8) is not used.
+
+The acceleration loop
+---------------------
+``[model] inner_loop = "acceleration"`` (:mod:`tmem.model.quadrotor`).  The flight controller
+runs, per axis, the paper's attitude model (1) as a reference, the tilt the linear agent would have::
 
     phi_r' = omega_r,   omega_r' = kp kd (U - phi_r) - kd omega_r              (Q9)
 
@@ -43,7 +87,7 @@ import numpy as np
 
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from .linear import state_matrices, zero_order_hold
-from .rigid_body import rotation, wrench
+from .rigid_body import rotation, rotor_commands, wrench
 
 #: The reference (Q9) in the body state, after the gusts: each axis's tilt and its rate.
 REFERENCE_NAMES = ("phi_r_x", "omega_r_x", "phi_r_y", "omega_r_y")
@@ -170,3 +214,57 @@ def reported_coordinates(c_h: float, g: float) -> np.ndarray:
     t = np.eye(4)
     t[2, 1], t[3, 2] = c_h / g, c_h
     return t
+
+
+@numba.njit(cache=True, inline="always")
+def flight_commands(s, ux, uy, params, wind):
+    """Collective thrust and body-rate set-points ``(T, w_x,d, w_y,d, w_z,d)``, (Q5), (Q7) and (Q8).
+
+    The feed-forward (Q8) balances the aerodynamic force the vehicle feels, the drag of its
+    airspeed: an accelerometer measures it (the specific force less the rotors' thrust), with no
+    knowledge of the wind.
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state.
+    ux, uy : float
+        Tilt set-points ``U`` on x and y (rad).
+    params : QuadrotorStep
+    wind : tuple of 3 float
+        The wind (m/s, world frame), (D1) of :mod:`tmem.model.wind`.
+    """
+    frame = params
+    r = rotation(s[6], s[7], s[8], s[9])
+    if params.feedforward:
+        _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, wind)
+        weight = frame.mass * frame.g
+        ux += math.atan(-(r[0] * ax + r[1] * ay + r[2] * az) / weight)
+        uy += math.atan(-(r[3] * ax + r[4] * ay + r[5] * az) / weight)
+    b3z = r[8]
+    thrust = frame.mass * (frame.g - params.altitude_kp * s[2] - params.altitude_kd * s[5]) / b3z
+    rate_x = -params.kp * (uy - math.atan2(r[5], b3z))
+    rate_y = params.kp * (ux - math.atan2(r[2], b3z))
+    rate_z = -params.kp * math.atan2(r[3], r[0])
+    return thrust, rate_x, rate_y, rate_z
+
+
+@numba.njit(cache=True, inline="always")
+def rate_loop(s, thrust, rate_x, rate_y, rate_z, params):
+    """The rotor speeds commanded for the thrust and the body rates asked for: (Q6), then the allocation.
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state.
+    thrust : float
+        Collective thrust (N).
+    rate_x, rate_y, rate_z : float
+        Body-rate set-points (rad/s).
+    params : QuadrotorStep
+    """
+    frame, kd = params, params.kd
+    mx = frame.ixx * kd * (rate_x - s[10])
+    my = frame.iyy * kd * (rate_y - s[11])
+    mz = frame.izz * kd * (rate_z - s[12])
+    return rotor_commands(thrust, mx, my, mz, frame)
