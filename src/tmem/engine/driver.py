@@ -266,8 +266,8 @@ def simulate(
     swarm = _in_slots(scenario, initial, gains, record, model.initial_body(initial.state))
     x = swarm.agents.state
     lister, measured, sensed = _lists_and_measurement(scenario, run, swarm, gains, sensing)
-    advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM, sensed, scenario.gas_observed)
     gas = gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0])
+    advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM, sensed, gas.observe)
     stages = (law, params, model.step_params(sim.dt), measured, gas, wall_params(params, gas.wall_reach))
     _drive(advance, run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)
     if not np.all(np.isfinite(x[swarm.agents.active])):
