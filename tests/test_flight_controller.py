@@ -12,11 +12,11 @@ from scipy.linalg import expm
 
 import tmem
 from tmem.metrics import formation_summary, summarize
-from tmem.model.flight_controller import acceleration_setpoints, advance_reference
+from tmem.model.flight_controller import acceleration_loop, advance_reference
 from tmem.model.linear import state_matrices
-from tmem.model.flight_controller import flight_commands, rate_loop
+from tmem.model.flight_controller import rate_loop
 from tmem.model.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, step_quadrotor
-from tmem.model.rigid_body import derivative
+from tmem.model.rigid_body import derivative, loads
 from tmem.scenario import QuadrotorModelParams, WindParams
 
 CALM = (0.0, 0.0, 0.0)
@@ -55,8 +55,7 @@ def closed_loop_slope(model: QuadrotorModel, axis: int, y: np.ndarray, u: float)
     setpoint = (u, 0.0) if axis == 0 else (0.0, u)
     params = model.step_params(model.params.inner_period)
     for _ in range(30):  # the rotors at their command: a fixed point (the set-points read their drag)
-        tilts = acceleration_setpoints(s, tuple(ref), *setpoint, params, CALM)
-        command = rate_loop(s, *flight_commands(s, *tilts, params, CALM), params)
+        command = rate_loop(s, *acceleration_loop(s, loads(s, params, CALM), tuple(ref), *setpoint, params), params)
         s = s[:13] + command
     slope = np.array(derivative(s, command, params, CALM))
     eps = 1e-6

@@ -2,9 +2,9 @@
 
 RotorPy (``rotorpy.vehicles.multirotor.Multirotor``, MIT) integrates the same
 Crazyflie with scipy's adaptive Runge-Kutta from its own equations; it is fed
-the commands of tmem's flight controller (collective thrust and body rates,
-its ``cmd_ctbr`` abstraction with ``k_w = kd``), computed from RotorPy's own
-state at every inner-loop period.  What is compared is the rigid body, the
+the commands of tmem's flight controller, under either inner loop (collective
+thrust and body rates, its ``cmd_ctbr`` abstraction with ``k_w = kd``), computed
+from RotorPy's own state at every inner-loop period.  What is compared is the rigid body, the
 rotors, their allocation and lag, and the integration.
 """
 
@@ -15,19 +15,19 @@ import math
 import numpy as np
 import pytest
 
-from tmem.model.flight_controller import flight_commands, rate_loop
+from tmem.model.flight_controller import acceleration_loop, advance_reference, initial_reference, rate_loop, tilt_loop
 from tmem.model.quadrotor import GUSTS, QuadrotorModel, axis_view, step_quadrotor
-from tmem.model.rigid_body import derivative, hover_speed
+from tmem.model.rigid_body import derivative, hover_speed, loads
 from tmem.model.linear import state_matrices
 from tmem.scenario import QuadrotorModelParams
 
-#: The inner period of the comparison with RotorPy (s): one RK4 sub-step per step.
+#: The inner period of the comparison with RotorPy (s): one sub-step per step.
 PERIOD = 0.01
 DURATION = 10.0
 
 #: Tilt set-points ``(U_x, U_y)`` (rad) over time (s).  RotorPy takes 3 to 8 s a manoeuvre here: the
-#: two that exercise both axes and a varying command run always, the others with ``-m slow``
-#: (docs/scripts/vehicles.py prints the errors of all five).
+#: two that exercise both axes and a varying command run always under the tilt loop, one under the
+#: acceleration loop, the others with ``-m slow`` (docs/scripts/vehicles.py prints the errors of all five).
 MANOEUVRES = {
     "hover": lambda t: (0.0, 0.0),
     "step x": lambda t: (0.1 if t >= 1.0 else 0.0, 0.0),
@@ -35,14 +35,14 @@ MANOEUVRES = {
     "sine x": lambda t: (0.1 * math.sin(2.0 * math.pi * 0.5 * t), 0.0),
     "step both": lambda t: (0.07 if t >= 1.0 else 0.0, 0.05 if t >= 2.0 else 0.0),
 }
-ALWAYS = ("sine x", "step both")
+ALWAYS = (("sine x", "tilt"), ("step both", "tilt"), ("step both", "acceleration"))
 #: No wind (m/s).
 CALM = (0.0, 0.0, 0.0)
 
 
 def quadrotor(**changes) -> QuadrotorModel:
-    """The tilt loop (Q5)-(Q8), whose commands RotorPy is fed (tests/test_flight_controller.py: the acceleration loop)."""
-    return QuadrotorModel(QuadrotorModelParams(kind="quadrotor", inner_loop="tilt", **changes))
+    """The tilt loop (Q5)-(Q8), unless ``changes`` say otherwise (tests/test_flight_controller.py: the acceleration loop)."""
+    return QuadrotorModel(QuadrotorModelParams(**{"kind": "quadrotor", "inner_loop": "tilt", **changes}))
 
 
 def packed(x: np.ndarray, body: np.ndarray) -> tuple:
@@ -80,18 +80,29 @@ def fly_rotorpy(model: QuadrotorModel, setpoint, first: np.ndarray, wind=(0.0, 0
     state = {"x": first[0:3], "v": first[3:6], "q": first[6:10], "w": first[10:13], "wind": np.zeros(3), "rotor_speeds": first[13:]}
     params = model.step_params(PERIOD)
     states = [first]
+    if params.acceleration:  # the reference (Q9) starts as the model's own does (QuadrotorModel.initial_body)
+        tilts = axis_view(tuple(first))
+        ref = tuple(initial_reference(tuple(first), tilts[0::2], tilts[1::2], params, p.g, tuple(air.update(0.0, first[:3]))))
     for k in range(round(DURATION / PERIOD)):
         s = tuple(np.concatenate([state["x"], state["v"], state["q"], state["w"], state["rotor_speeds"]]))
         state["wind"] = air.update(k * PERIOD, state["x"])  # as RotorPy's Environment sets it
-        thrust, *rates = flight_commands(s, *setpoint(k * PERIOD), params, tuple(state["wind"]))
+        loaded, u = loads(s, params, tuple(state["wind"])), setpoint(k * PERIOD)
+        if params.acceleration:
+            thrust, *rates = acceleration_loop(s, loaded, ref, *u, params)
+            ref = advance_reference(ref, *u, params)
+        else:
+            thrust, *rates = tilt_loop(s, loaded, *u, params)
         state = vehicle.step(state, {"cmd_thrust": thrust, "cmd_w": np.array(rates)}, PERIOD)
         states.append(np.concatenate([state["x"], state["v"], state["q"], state["w"], state["rotor_speeds"]]))
     return np.array(states)
 
 
-@pytest.mark.parametrize("name", [n if n in ALWAYS else pytest.param(n, marks=pytest.mark.slow) for n in MANOEUVRES])
-def test_the_compiled_quadrotor_flies_as_rotorpy_integrates_it(name):
-    model = quadrotor(inner_period=PERIOD)
+@pytest.mark.parametrize(("name", "inner_loop"), [
+    (n, loop) if (n, loop) in ALWAYS else pytest.param(n, loop, marks=pytest.mark.slow)
+    for n in MANOEUVRES for loop in ("tilt", "acceleration")
+])  # fmt: skip
+def test_the_compiled_quadrotor_flies_as_rotorpy_integrates_it(name, inner_loop):
+    model = quadrotor(inner_period=PERIOD, inner_loop=inner_loop)
     start = np.zeros((1, 2, 4))
     start[0, :, 1] = (1.0, -0.5)  # under way, so that the drag and its feed-forward are at work
     ours = fly_tmem(model, MANOEUVRES[name], start)
@@ -111,7 +122,7 @@ def axis_derivative(model: QuadrotorModel, axis: int, x: np.ndarray, u: float) -
     s = packed(state, model.initial_body(state))
     params = model.step_params(model.params.inner_period)
     for _ in range(20):  # the rotors at their command: a fixed point (the feed-forward reads their drag)
-        command = rate_loop(s, *flight_commands(s, *((u, 0.0) if axis == 0 else (0.0, u)), params, CALM), params)
+        command = rate_loop(s, *tilt_loop(s, loads(s, params, CALM), *((u, 0.0) if axis == 0 else (0.0, u)), params), params)
         s = s[:13] + command
     slope = np.array(derivative(s, command, params, CALM))
     eps = 1e-6

@@ -12,6 +12,7 @@ printed here.
 
 from __future__ import annotations
 
+import itertools
 import sys
 from pathlib import Path
 
@@ -30,10 +31,10 @@ from tmem.scenario import QuadrotorModelParams, from_dict, load  # noqa: E402
 
 
 def against_rotorpy() -> None:
-    print("| manoeuvre | largest position error (m) | largest attitude error (deg) | distance flown (m) |")
-    print("| --- | --- | --- | --- |")
-    for name, setpoint in manoeuvres.MANOEUVRES.items():
-        model = manoeuvres.quadrotor(inner_period=manoeuvres.PERIOD)
+    print("| manoeuvre | inner loop | largest position error (m) | largest attitude error (deg) | distance flown (m) |")
+    print("| --- | --- | --- | --- | --- |")
+    for (name, setpoint), inner_loop in itertools.product(manoeuvres.MANOEUVRES.items(), ("tilt", "acceleration")):
+        model = manoeuvres.quadrotor(inner_period=manoeuvres.PERIOD, inner_loop=inner_loop)
         start = np.zeros((1, 2, 4))
         start[0, :, 1] = (1.0, -0.5)
         ours = manoeuvres.fly_tmem(model, setpoint, start)
@@ -42,7 +43,7 @@ def against_rotorpy() -> None:
         dot = np.abs(np.sum(ours[:, 6:10] * theirs[:, 6:10], axis=1) / np.linalg.norm(theirs[:, 6:10], axis=1))
         attitude = np.degrees(np.max(2.0 * np.arccos(np.minimum(dot, 1.0))))
         flown = np.sum(np.linalg.norm(np.diff(ours[:, :3], axis=0), axis=1))
-        print(f"| {name} | {position:.1e} | {attitude:.1e} | {flown:.1f} |")
+        print(f"| {name} | {inner_loop} | {position:.1e} | {attitude:.1e} | {flown:.1f} |")
 
 
 def with_lag(model: QuadrotorModel, gains: np.ndarray, tau: float) -> np.ndarray:

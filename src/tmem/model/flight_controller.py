@@ -87,7 +87,7 @@ import numpy as np
 
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from .linear import state_matrices, zero_order_hold
-from .rigid_body import rotation, rotor_commands, wrench
+from .rigid_body import loads, rotor_commands
 
 #: The reference (Q9) in the body state, after the gusts: each axis's tilt and its rate.
 REFERENCE_NAMES = ("phi_r_x", "omega_r_x", "phi_r_y", "omega_r_y")
@@ -139,35 +139,45 @@ def advance_reference(ref, ux, uy, params):
 
 
 @numba.njit(cache=True, inline="always")
-def acceleration_setpoints(s, ref, ux, uy, params, wind):
-    """Tilt set-points ``(phi_d,x, phi_d,y)`` for the attitude loop (Q5), (Q10)-(Q11).
+def acceleration_loop(s, loaded, ref, ux, uy, params):
+    """Collective thrust and body-rate set-points ``(T, w_x,d, w_y,d, w_z,d)`` of the acceleration loop:
+    (Q10)-(Q11), then (Q5) and (Q7) (:func:`attitude_commands`).
+
+    The attitude loop (Q5) needs each axis's error ``phi_d,a - phi_a``, with ``phi_d,a`` (Q11)
+    ``theta_a`` plus the reference's terms.  ``theta_a - phi_a``, the angle from the thrust axis
+    to the thrust asked for (Q10), seen along the other axis, is computed as one angle,
+    ``atan2(f_a b_3z - f_z b_3a, f_z b_3z + f_a b_3a)``: the difference of the two ``atan2``
+    while both lie within (-pi/2, pi/2) (``f_z`` and ``b_3z`` positive, a vehicle upright and
+    holding its height), and the shorter way round otherwise.
 
     Parameters
     ----------
     s : tuple of 17 float
         The body's state (:mod:`tmem.model.rigid_body`).
+    loaded : tuple
+        Its attitude and the wrench on it, :func:`~tmem.model.rigid_body.loads` (in the wind).
     ref : tuple of 4 float
         The reference (Q9) now.
     ux, uy : float
         Tilt set-points ``U`` on x and y (rad).
     params : QuadrotorStep
-    wind : tuple of 3 float
-        The wind (m/s, world frame).
     """
     frame = params
-    r = rotation(s[6], s[7], s[8], s[9])
-    _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, wind)
+    r, (_, _, _, _, _, _, ax, ay, az) = loaded
     force_z = frame.g - params.altitude_kp * s[2] - params.altitude_kd * s[5]
-    theta_x = math.atan2(frame.g * ref[0] - (r[0] * ax + r[1] * ay + r[2] * az) / frame.mass, force_z)
-    theta_y = math.atan2(frame.g * ref[2] - (r[3] * ax + r[4] * ay + r[5] * az) / frame.mass, force_z)
+    force_x = frame.g * ref[0] - (r[0] * ax + r[1] * ay + r[2] * az) / frame.mass
+    force_y = frame.g * ref[2] - (r[3] * ax + r[4] * ay + r[5] * az) / frame.mass
+    b3x, b3y, b3z = r[2], r[5], r[8]
+    lean_x = math.atan2(force_x * b3z - force_z * b3x, force_z * b3z + force_x * b3x)  # theta_x - phi_x
+    lean_y = math.atan2(force_y * b3z - force_z * b3y, force_z * b3z + force_y * b3y)
     rotors = s[13] + s[14] + s[15] + s[16]
     c = frame.k_d * rotors / frame.mass
     inflow = frame.k_z * frame.offset * frame.offset * rotors
     c_rx, c_ry = inflow / frame.iyy, inflow / frame.ixx
     kpkd, kd = params.kp * params.kd, params.kd
-    phi_x = theta_x + ux - ref[0] + ((c + c_rx) * ref[1] + (kd + c_rx) * c * ref[0]) / kpkd
-    phi_y = theta_y + uy - ref[2] + ((c + c_ry) * ref[3] + (kd + c_ry) * c * ref[2]) / kpkd
-    return phi_x, phi_y
+    error_x = lean_x + ux - ref[0] + ((c + c_rx) * ref[1] + (kd + c_rx) * c * ref[0]) / kpkd
+    error_y = lean_y + uy - ref[2] + ((c + c_ry) * ref[3] + (kd + c_ry) * c * ref[2]) / kpkd
+    return attitude_commands(s, r, error_x, error_y, params)
 
 
 def initial_reference(s: tuple, tilts: tuple[float, float], rates: tuple[float, float], frame, g: float, wind: tuple) -> np.ndarray:
@@ -189,8 +199,7 @@ def initial_reference(s: tuple, tilts: tuple[float, float], rates: tuple[float, 
     wind : tuple of 3 float
         The wind of the first step (m/s, world frame).
     """
-    r = rotation(s[6], s[7], s[8], s[9])
-    _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, wind)
+    r, (_, _, _, _, _, _, ax, ay, az) = loads(s, frame, wind)
     c = frame.k_d * sum(s[13:17]) / frame.mass
     drag = ((r[0] * ax + r[1] * ay + r[2] * az) / frame.mass, (r[3] * ax + r[4] * ay + r[5] * az) / frame.mass)
     phi = [math.tan(t) + d / g for t, d in zip(tilts, drag)]
@@ -217,8 +226,9 @@ def reported_coordinates(c_h: float, g: float) -> np.ndarray:
 
 
 @numba.njit(cache=True, inline="always")
-def flight_commands(s, ux, uy, params, wind):
-    """Collective thrust and body-rate set-points ``(T, w_x,d, w_y,d, w_z,d)``, (Q5), (Q7) and (Q8).
+def tilt_loop(s, loaded, ux, uy, params):
+    """Collective thrust and body-rate set-points ``(T, w_x,d, w_y,d, w_z,d)`` of the tilt loop:
+    (Q8), then (Q5) and (Q7) (:func:`attitude_commands`).
 
     The feed-forward (Q8) balances the aerodynamic force the vehicle feels, the drag of its
     airspeed: an accelerometer measures it (the specific force less the rotors' thrust), with no
@@ -228,23 +238,41 @@ def flight_commands(s, ux, uy, params, wind):
     ----------
     s : tuple of 17 float
         The body's state.
+    loaded : tuple
+        Its attitude and the wrench on it, :func:`~tmem.model.rigid_body.loads` (in the wind,
+        (D1) of :mod:`tmem.model.wind`).
     ux, uy : float
         Tilt set-points ``U`` on x and y (rad).
     params : QuadrotorStep
-    wind : tuple of 3 float
-        The wind (m/s, world frame), (D1) of :mod:`tmem.model.wind`.
     """
     frame = params
-    r = rotation(s[6], s[7], s[8], s[9])
+    r, (_, _, _, _, _, _, ax, ay, az) = loaded
     if params.feedforward:
-        _, _, _, _, _, _, ax, ay, az = wrench(s, r, frame, wind)
         weight = frame.mass * frame.g
         ux += math.atan(-(r[0] * ax + r[1] * ay + r[2] * az) / weight)
         uy += math.atan(-(r[3] * ax + r[4] * ay + r[5] * az) / weight)
     b3z = r[8]
-    thrust = frame.mass * (frame.g - params.altitude_kp * s[2] - params.altitude_kd * s[5]) / b3z
-    rate_x = -params.kp * (uy - math.atan2(r[5], b3z))
-    rate_y = params.kp * (ux - math.atan2(r[2], b3z))
+    return attitude_commands(s, r, ux - math.atan2(r[2], b3z), uy - math.atan2(r[5], b3z), params)
+
+
+@numba.njit(cache=True, inline="always")
+def attitude_commands(s, r, error_x, error_y, params):
+    """Collective thrust (Q7) and body-rate set-points (Q5) ``(T, w_x,d, w_y,d, w_z,d)`` for the tilt errors.
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state.
+    r : tuple of 9 float
+        Its attitude's rotation (:func:`~tmem.model.rigid_body.rotation`).
+    error_x, error_y : float
+        Each axis's ``phi_d,a - phi_a`` (rad).
+    params : QuadrotorStep
+    """
+    frame = params
+    thrust = frame.mass * (frame.g - params.altitude_kp * s[2] - params.altitude_kd * s[5]) / r[8]
+    rate_x = -params.kp * error_y
+    rate_y = params.kp * error_x
     rate_z = -params.kp * math.atan2(r[3], r[0])
     return thrust, rate_x, rate_y, rate_z
 

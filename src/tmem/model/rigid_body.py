@@ -161,6 +161,25 @@ def wrench(s, r, frame, wind):
 
 
 @numba.njit(cache=True, inline="always")
+def loads(s, frame, wind):
+    """``(R, wrench)``: the attitude's :func:`rotation` and the :func:`wrench` on the body in state ``s``.
+
+    What (Q1)-(Q3) read, and what a flight controller measures (its attitude, and the
+    aerodynamic force from its accelerometer): computed once per state and handed to both.
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state (module text).
+    frame : Airframe
+    wind : tuple of 3 float
+        The wind (m/s, world frame).
+    """
+    r = rotation(s[6], s[7], s[8], s[9])
+    return r, wrench(s, r, frame, wind)
+
+
+@numba.njit(cache=True, inline="always")
 def derivative(s, command, frame, wind):
     """``s'`` of (Q1)-(Q4): the body's state changing under the rotor speeds ``command``.
 
@@ -174,8 +193,24 @@ def derivative(s, command, frame, wind):
     wind : tuple of 3 float
         The wind (m/s, world frame).
     """
-    r = rotation(s[6], s[7], s[8], s[9])
-    fx, fy, fz, mx, my, mz, _, _, _ = wrench(s, r, frame, wind)
+    return derivative_under(s, loads(s, frame, wind), command, frame)
+
+
+@numba.njit(cache=True, inline="always")
+def derivative_under(s, loaded, command, frame):
+    """``s'`` of (Q1)-(Q4) with the state's :func:`loads` already computed.
+
+    Parameters
+    ----------
+    s : tuple of 17 float
+        The body's state (module text).
+    loaded : tuple
+        ``loads(s, frame, wind)``.
+    command : tuple of 4 float
+        The rotors' commanded speeds ``c_k`` (rad/s).
+    frame : Airframe
+    """
+    r, (fx, fy, fz, mx, my, mz, _, _, _) = loaded
     qx, qy, qz, qw = s[6], s[7], s[8], s[9]
     wx, wy, wz = s[10], s[11], s[12]
     inverse_tau, inverse_mass = 1.0 / frame.tau_m, 1.0 / frame.mass
