@@ -1,5 +1,6 @@
 """Running sweeps: rows against single runs, failures, interruption and resume, a real Dask cluster."""
 
+import json
 import os
 import signal
 import subprocess
@@ -18,7 +19,8 @@ from tmem.scenario import with_changes
 from tmem.sweep import SweepInterrupted, loads_sweep, run_sweep
 from tmem.sweep.report import coupling_statistics, rms_statistics
 from tmem.sweep.spec import SCALAR_METRICS
-from tmem.sweep.tasks import plan_chunks, run_chunk
+from tmem.sweep.store import ResultStore
+from tmem.sweep.tasks import plan_chunks, row, run_chunk
 
 # Short, coarse runs: the paper's pair with random starts, both coupling functions.
 ENCOUNTERS = """
@@ -97,6 +99,20 @@ def test_explicit_cases_with_different_keys_in_the_plane(cluster, tmp_path):
         assert (pd.isna(row.uncouple_rule) and one["uncouple_rule"] is None) or row.uncouple_rule == one["uncouple_rule"]
     assert set(table["uncouple_rule"].dropna()) <= {"window", "energy", "fallback"}
     assert "## What released the pairs" in (tmp_path / "out" / "summary.md").read_text()
+
+
+def test_a_vector_key_that_a_case_leaves_out_is_empty_in_its_row(tmp_path):
+    """A constant wind set by one case and left out by the reference, both in one part: the
+    reference's row has no wind (null, not the JSON text of NaN), the other its vector as JSON."""
+    sweep = loads_sweep('name = "wind"\nbase = "../vehicles/fig9.toml"\nmetrics = ["rms_change_percent"]\n'
+                        'case = [{}, { "wind.velocity" = [1.0] }]\n', source="wind.toml",
+                        directory=Path(__file__).parent.parent / "examples" / "sweeps")  # fmt: skip
+    store = ResultStore.check(tmp_path / "out", sweep)
+    with store.opened():
+        store.add([row(case, ("rms_change_percent",), {"rms_change_percent": 0.0}, None, 0.0) for case in sweep.cases()])
+        table = store.table()
+    assert table["wind.velocity"].isna().tolist() == [True, False]
+    assert json.loads(table["wind.velocity"][1]) == [1.0]
 
 
 def test_a_failing_case_is_a_row_with_its_error_and_the_others_run():

@@ -21,21 +21,12 @@ import time
 from pathlib import Path
 
 from survive import (  # first: it selects matplotlib's file backend
-    BAND, EXAMPLES, FIG9_COLUMNS, FIG9_METRICS, HEX_COLUMNS, HEX_METRICS, IMAGES, WIND_AXES, describe_case, draw_panels,
-    fig9_values, hex_values, load, print_first_pass, print_references, read, references, save, table, tmem, with_changes,
+    BAND, EXAMPLES, FIG9_COLUMNS, FIG9_METRICS, HEX_COLUMNS, HEX_METRICS, IMAGES, WIND_AXES, draw_panels, fig9_values,
+    hex_values, load, print_band, print_first_pass, print_references, read, references, save, table, tmem, with_changes,
 )
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-
-
-def print_band(rows) -> None:
-    """The hex's shape: each case's largest edge error over the last 20 s beside the reference's and :data:`BAND`."""
-    metric = "formation.distance_error_last_20s.max"
-    reference = rows[rows["axis"].isna()][metric].iloc[0]
-    kept = rows[rows[metric] <= BAND]
-    print(f"within {BAND} m over the last 20 s: {len(kept)} of {len(rows)} cases; largest edge error over the last 20 s "
-          f"against the reference's {reference:.2f} m: " + ", ".join(f"{describe_case(r)}: {r[metric]:.2f}" for _, r in rows[rows['axis'].notna()].iterrows()))  # fmt: skip
 
 
 def check_reference(out: Path, name: str, rows) -> None:

@@ -78,6 +78,8 @@ def on_two_axes(scenario):
     data["space"] = {**data["space"], "axes": 2}
     for agent in data["agents"]:
         agent["position"], agent["velocity"] = [agent["position"], 0.0], [agent["velocity"], 0.0]
+        if "tilt" in agent:  # examples/vehicles/fig9.toml starts its agents trimmed
+            agent["tilt"] = [agent["tilt"], 0.0]
     return from_dict(data)
 
 

@@ -219,8 +219,8 @@ class ResultStore:
         for column in self.sweep.parameters:
             if column not in frame:  # set by other explicit cases than these
                 frame[column] = None
-            if frame[column].map(lambda v: isinstance(v, list | dict)).any():
-                frame[column] = frame[column].map(json.dumps)  # a vector value, as JSON text
+            if frame[column].map(lambda v: isinstance(v, list | dict)).any():  # a vector value, as JSON text;
+                frame[column] = frame[column].map(lambda v: None if v is None or v != v else json.dumps(v))  # left out: none
         for metric in self.metrics:
             frame[metric] = frame[metric].astype(METRIC_TYPES.get(metric, "float64"))
         frame["error"] = frame["error"].astype("string")
