@@ -291,3 +291,21 @@ def test_tasks_the_cluster_loses_leave_their_cases_to_run_again(tmp_path, monkey
         monkeypatch.setattr("tmem.sweep.runner.run_chunk", real)
         resumed = run_sweep(sweep, tmp_path / "out", scheduler=threads.scheduler_address)
     assert resumed.ran == 3 and list(resumed.table["case"]) == list(range(12))
+
+
+def test_a_local_cluster_that_does_not_close_in_time_leaves_no_worker(monkeypatch):
+    import multiprocessing
+
+    from dask.distributed import LocalCluster as Local
+
+    from tmem.sweep.cluster import dask_client
+
+    def times_out(self, *args, **kwargs):  # as a worker that does not answer the shutdown in time
+        raise TimeoutError
+
+    before = set(multiprocessing.active_children())
+    with dask_client(None, 1) as client:
+        assert client.submit(sum, [1, 2]).result() == 3
+        assert set(multiprocessing.active_children()) - before  # the worker's process
+        monkeypatch.setattr(Local, "close", times_out)
+    assert set(multiprocessing.active_children()) <= before

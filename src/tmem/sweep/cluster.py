@@ -251,13 +251,21 @@ def _start_local_cluster(workers: int):
 def _local_client(workers: int | None) -> Iterator:
     from dask.distributed import Client
 
+    import multiprocessing
+
+    before = set(multiprocessing.active_children())
     cluster = _start_local_cluster(workers or os.cpu_count() or 1)
     client = Client(cluster, set_as_default=False)
     try:
         yield client
     finally:
         client.close()
-        cluster.close()
+        try:
+            cluster.close()
+        except TimeoutError:  # a worker too slow to answer (a loaded or paused machine): its rows are saved
+            for worker in set(multiprocessing.active_children()) - before:  # none may outlive the command
+                worker.kill()
+                worker.join(timeout=5)
 
 
 @contextmanager
