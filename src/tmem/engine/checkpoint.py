@@ -89,7 +89,7 @@ ROWS = {
     **{("events", f): "n_events" for f in Events._fields},
 }
 #: Raised to the checkpoint's file format when it changes.
-FORMAT = 1
+FORMAT = 2
 
 
 class CheckpointError(ValueError):

@@ -13,10 +13,12 @@ The derivations are in ``docs/gas.md``; equation labels below refer to it.
   ``c_max`` (from 0 at the edge of reach to 1 at saturation), so that a neighbour coming within
   reach changes the weights smoothly: counted whole at once, each arrival would jolt the others'
   pushes.  With one neighbour nothing changes.
-* **Thermostat (T1)-(T2).**  Each agent estimates the temperature from what it knows: its own
-  energy and its neighbours' within reach, each ``|V|^2`` plus the energy its pushes hold,
-  ``(g |U| / omega)^2`` with ``omega`` its slow mode's frequency (T2).  It tilts along its velocity
-  so that ``dV/dt = (T* / T_i - 1) V / (2 tau)``: Berendsen's weak coupling, applied per agent.
+* **Thermostat (T1)-(T2).**  Each agent estimates the temperature from its own state (T2): its
+  ``|V|^2``, plus the energy its pushes hold, ``S_i = (g |U| / omega)^2`` with ``omega`` its slow
+  mode's frequency, less the share of ``T*`` its pushes have held on average since the start.  An
+  encounter reads as warm as it is, and the swarm's kinetic energy, the RMS velocity, is what is
+  held.  It tilts along its velocity so that ``dV/dt = (T* / T_i - 1) V / (2 tau)``: Berendsen's
+  weak coupling, applied per agent.
 * **Walls and obstacles (W1)-(W2)** are neighbours held still, with the last word on the
   set-point: :mod:`tmem.engine.walls`.
 
@@ -59,17 +61,18 @@ WALL_MOMENTUM, WALL_VIRIAL, VIRIAL_TOTAL, ENCOUNTERS, PATH, BREACHES = range(len
 #: the virial theorem's boundary term, m^2/s).
 SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
 #: Columns of ``Gas.work``, one row per agent, cleared at each step: neighbours within reach, their
-#: pushes' squared sizes over ``c_max^2``, their energies, the agent's virial (rad m), its ``|V|^2``,
-#: its energy, the size of the box walls' pushes (rad) and their moment about the walls (rad m).
-NEAR, CONTACT, NEAR_ENERGY, VIRIAL, SPEED2, ENERGY, WALL_PUSH, WALL_MOMENT = range(8)
+#: pushes' squared sizes over ``c_max^2``, the agent's virial (rad m), its ``|V|^2``, the size of the
+#: box walls' pushes (rad) and their moment about the walls (rad m).
+NEAR, CONTACT, VIRIAL, SPEED2, WALL_PUSH, WALL_MOMENT = range(6)
 #: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
-#: step before, contacts at the step before (C1), the energy its pushes held (T2), its tilt limit.
-NEAR_BEFORE, CROWD, STORED, LIMIT = range(4)
+#: step before, contacts at the step before (C1), the energy its pushes held (T2), its tilt limit,
+#: the mean share of ``T*`` its pushes held over the steps of the thermostat (T2), and those steps.
+NEAR_BEFORE, CROWD, STORED, LIMIT, SHARE, STEPS = range(6)
 
 
 @numba.njit(cache=True, inline="always")
 def clear(i, known, work, kept, c_max, n_axes):
-    """Start agent ``i``'s step: nothing counted yet; its own ``|V|^2`` and energy as known.
+    """Start agent ``i``'s step: nothing counted yet; its own ``|V|^2`` as known.
 
     Called in a parallel loop: it takes the record's arrays, not the record.
 
@@ -92,7 +95,6 @@ def clear(i, known, work, kept, c_max, n_axes):
     for c in range(work.shape[1]):
         work[i, c] = 0.0
     work[i, SPEED2] = speed2
-    work[i, ENERGY] = speed2 + kept[i, STORED]
     kept[i, LIMIT] = c_max
 
 
@@ -112,8 +114,8 @@ def pair_share(i, j, kept):
 
 @numba.njit(cache=True, inline="always")
 def add_contact(i, j, pressing, virial, work):
-    """Count the pair ``(i, j)`` within reach for both agents: its push's squared size over ``c_max^2``, each
-    other's energy, and the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
+    """Count the pair ``(i, j)`` within reach for both agents: its push's squared size over ``c_max^2`` and
+    the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
 
     Parameters
     ----------
@@ -130,8 +132,6 @@ def add_contact(i, j, pressing, virial, work):
     work[j, NEAR] += 1.0
     work[i, CONTACT] += pressing
     work[j, CONTACT] += pressing
-    work[i, NEAR_ENERGY] += work[j, ENERGY]
-    work[j, NEAR_ENERGY] += work[i, ENERGY]
     work[i, VIRIAL] += virial
     work[j, VIRIAL] += virial
 
@@ -150,13 +150,15 @@ def _stiffness(near, crowd, mean):
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def _thermostat(i, known, setpoint, pushed, work, kept, contacts, mean, rate, target2, inv_g, energy_scale, n_axes):
     """Add agent ``i``'s thermostat push (T1) along its velocity, from its estimate of the
-    temperature (T2): the mean energy of itself and its neighbours within reach."""
+    temperature (T2): its ``|V|^2`` and the energy its pushes hold now, less what they hold on average."""
     pushed2 = 0.0
     for a in range(n_axes):
         total = setpoint[i, a] + (pushed[i, a] if contacts > 0 else 0.0)
         pushed2 += total * total
     kept[i, STORED] = energy_scale * pushed2 / _stiffness(work[i, NEAR], kept[i, CROWD], mean)
-    temperature = (work[i, SPEED2] + kept[i, STORED] + work[i, NEAR_ENERGY]) / (1.0 + work[i, NEAR])
+    kept[i, STEPS] += 1.0
+    kept[i, SHARE] += (kept[i, STORED] / target2 - kept[i, SHARE]) / kept[i, STEPS]
+    temperature = work[i, SPEED2] + kept[i, STORED] - kept[i, SHARE] * target2
     push = rate * (target2 / temperature - 1.0) * inv_g if temperature > 0.0 else 0.0
     for a in range(n_axes):
         setpoint[i, a] += push * known[i, a, 1]
@@ -356,8 +358,8 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         energy_scale=(acceleration_per_tilt / scenario.controller.im_r) ** 2,
         c_max=scenario.interaction.c_max,
         first=np.ones(1, dtype=np.bool_),
-        work=np.zeros((size, 8)),
-        kept=np.zeros((size, 4)),
+        work=np.zeros((size, 6)),
+        kept=np.zeros((size, 6)),
         pushed=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),
     )

@@ -268,13 +268,13 @@ class Gas(NamedTuple):
         The scenario's tilt limit (rad).
     first : ndarray, shape (1,), bool
         True until the first step's neighbours are counted: they are not encounters.
-    work : ndarray, shape (agents, 8) (no rows when not observed)
+    work : ndarray, shape (agents, 6) (no rows when not observed)
         Each agent's work space of a step, in the columns :data:`tmem.engine.gas.NEAR` ...
         :data:`tmem.engine.gas.WALL_MOMENT`: one row per agent, so that a pair's counts touch two
         rows.
-    kept : ndarray, shape (agents, 4)
+    kept : ndarray, shape (agents, 6)
         What each agent keeps from step to step (:data:`tmem.engine.gas.NEAR_BEFORE` ...
-        :data:`tmem.engine.gas.LIMIT`), among them its contacts, which it broadcasts (C1).
+        :data:`tmem.engine.gas.STEPS`), among them its contacts, which it broadcasts (C1).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)
