@@ -15,7 +15,7 @@ sub-step, and the quaternion is normalised after it, as RotorPy does after each 
 Three evaluations of (Q1)-(Q4) where RK4 takes four: with sub-steps of 10 ms, against RotorPy's
 adaptive RK45, positions agree within 5e-7 m and attitudes within 2e-4 deg over 10 s
 manoeuvres (RK4: 2e-8 m, 5e-6 deg; ``tests/test_quadrotor.py``, tolerance 1 cm and 0.1 deg),
-the error shrinking as the cube of the sub-step; and a sub-step costs a sixth less.
+the error shrinking as the cube of the sub-step; and a sub-step costs 13 % less (docs/vehicles.md, "Speed").
 
 State layout.  The engine keeps each axis's ``(P, V, phi, omega)`` (the TMEM
 law reads them) in ``state[i, a, :]`` and the rest of the body in the
