@@ -164,13 +164,9 @@ def _thermostat(i, known, setpoint, pushed, work, kept, contacts, mean, rate, ta
         setpoint[i, a] += push * known[i, a, 1]
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
-    """Agent ``i``'s part of :func:`gas_pushes`.
-
-    Called, not inlined: compiled once, it keeps the gas's code out of the step loop's compilation,
-    which it made a third longer for every scenario; the call costs nanoseconds against the agent's
-    work."""
+    """Agent ``i``'s part of :func:`gas_pushes`."""
     n_axes = len(box)
     walls = gas.walls
     obstacles = gas.obstacles
@@ -210,7 +206,7 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def gas_pushes(known, agents, gas, wall_params, run):
+def gas_pushes(known, agents, gas, wall_params, run, n_blocks):
     """The thermostat (T1)-(T2), then walls and obstacles (W1)-(W2), agent by agent
     (:func:`_gas_agent`), after the neighbour pushes and the formation pairs; count the neighbours
     that came within reach.
@@ -223,16 +219,30 @@ def gas_pushes(known, agents, gas, wall_params, run):
         The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.
     wall_params : tmem.interaction.kernels.FunctionParams
         The repulsion's parameters with ``R + R_w`` for its reach.
+    n_blocks : int
+        Blocks of agents the parallel loop shares out (those of :func:`tmem.engine.stages.corrected_positions`).
     """
     box = run.box
-    corrected = agents.corrected
-    setpoint = agents.setpoint
-    active = agents.active
     first = gas.first[0]
     gas.first[0] = False
-    for i in numba.prange(known.shape[0]):
-        if active[i]:
-            _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first)
+    n_agents = known.shape[0]
+    per_block = (n_agents + n_blocks - 1) // n_blocks
+    for b in numba.prange(n_blocks):
+        _gas_block(b * per_block, min(n_agents, (b + 1) * per_block), known, agents, gas, wall_params, box, first)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def _gas_block(begin, end, known, agents, gas, wall_params, box, first):
+    """Agents ``begin:end`` of :func:`gas_pushes`, one after the other.
+
+    Called, not inlined, once per block of agents: compiled once, the gas's code stays out of the
+    step loop's compilation, and out of Numba's transform of the parallel loop, which moved constant
+    assignments of the inlined agent's code out of the loop and gave the threaded loop other totals
+    than the serial one.  A call per agent cost more than the agent's work (its records passed each
+    time); a call per block costs nothing."""
+    for i in range(begin, end):
+        if agents.active[i]:
+            _gas_agent(i, known, agents.corrected, agents.setpoint, gas, wall_params, box, first)
 
 
 @numba.njit(cache=True, inline="always")

@@ -97,7 +97,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
             neighbour_pushes(agents, neighbours, law, params, run, gas)
             formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas)
         if OBSERVED:
-            gas_pushes(known, agents, gas, wall_params, run)
+            gas_pushes(known, agents, gas, wall_params, run, neighbours.block_shift2.shape[0])
         if is_recorded(k, run):
             record(agents, pairs, records, c_max, run, counters, gas, SENSED)
         if k < run.n_steps:
