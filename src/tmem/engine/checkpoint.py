@@ -89,7 +89,7 @@ ROWS = {
     **{("events", f): "n_events" for f in Events._fields},
 }
 #: Raised to the checkpoint's file format when it changes.
-FORMAT = 2
+FORMAT = 3
 
 
 class CheckpointError(ValueError):

@@ -65,9 +65,10 @@ SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
 #: box walls' pushes (rad) and their moment about the walls (rad m).
 NEAR, CONTACT, VIRIAL, SPEED2, WALL_PUSH, WALL_MOMENT = range(6)
 #: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
-#: step before, contacts at the step before (C1), the energy its pushes held (T2), its tilt limit,
-#: the mean share of ``T*`` its pushes held over the steps of the thermostat (T2), and those steps.
-NEAR_BEFORE, CROWD, STORED, LIMIT, SHARE, STEPS = range(6)
+#: step before, the weight of its pushes at the step before, ``1 / max(1, contacts)`` (C1), the energy
+#: its pushes held (T2), its tilt limit, the mean share of ``T*`` its pushes held over the steps of the
+#: thermostat (T2), and those steps.
+NEAR_BEFORE, WEIGHT, STORED, LIMIT, SHARE, STEPS = range(6)
 
 
 @numba.njit(cache=True, inline="always")
@@ -100,7 +101,9 @@ def clear(i, known, work, kept, c_max, n_axes):
 
 @numba.njit(cache=True, inline="always")
 def pair_share(i, j, kept):
-    """The factor (C1) divides the push of the pair ``(i, j)`` by: the larger of its agents' contacts.
+    """The weight (C1) of the push of the pair ``(i, j)``: one over the larger of its agents' contacts
+    (at least one), the smaller of their weights.  Each agent inverts its contacts once a step, so
+    that no pair divides.
 
     Parameters
     ----------
@@ -109,18 +112,20 @@ def pair_share(i, j, kept):
     kept : ndarray
         ``Gas.kept``.
     """
-    return 1.0 / max(1.0, kept[i, CROWD], kept[j, CROWD])
+    return min(kept[i, WEIGHT], kept[j, WEIGHT])
 
 
 @numba.njit(cache=True, inline="always")
-def add_contact(i, j, pressing, virial, work):
-    """Count the pair ``(i, j)`` within reach for both agents: its push's squared size over ``c_max^2`` and
-    the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
+def add_contact(i, j, near, pressing, virial, work):
+    """Count the pair ``(i, j)`` for both agents: whether it is within reach, its push's squared size
+    over ``c_max^2`` and the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
 
     Parameters
     ----------
     i, j : int
         The agents' slots.
+    near : float
+        1 if the pair is within reach, else 0 (its push and virial are then 0 too).
     pressing : float
         The pair's push's squared size over ``c_max^2``.
     virial : float
@@ -128,8 +133,8 @@ def add_contact(i, j, pressing, virial, work):
     work : ndarray
         ``Gas.work``, changed in place.
     """
-    work[i, NEAR] += 1.0
-    work[j, NEAR] += 1.0
+    work[i, NEAR] += near
+    work[j, NEAR] += near
     work[i, CONTACT] += pressing
     work[j, CONTACT] += pressing
     work[i, VIRIAL] += virial
@@ -148,14 +153,14 @@ def _stiffness(near, crowd, mean):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _thermostat(i, known, setpoint, pushed, work, kept, contacts, mean, rate, target2, inv_g, energy_scale, n_axes):
+def _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, mean, rate, target2, inv_g, energy_scale, n_axes):
     """Add agent ``i``'s thermostat push (T1) along its velocity, from its estimate of the
     temperature (T2): its ``|V|^2`` and the energy its pushes hold now, less what they hold on average."""
     pushed2 = 0.0
     for a in range(n_axes):
         total = setpoint[i, a] + (pushed[i, a] if contacts > 0 else 0.0)
         pushed2 += total * total
-    kept[i, STORED] = energy_scale * pushed2 / _stiffness(work[i, NEAR], kept[i, CROWD], mean)
+    kept[i, STORED] = energy_scale * pushed2 / _stiffness(work[i, NEAR], crowd, mean)
     kept[i, STEPS] += 1.0
     kept[i, SHARE] += (kept[i, STORED] / target2 - kept[i, SHARE]) / kept[i, STEPS]
     temperature = work[i, SPEED2] + kept[i, STORED] - kept[i, SHARE] * target2
@@ -182,12 +187,13 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
     if bounded:
         contacts, pressing, work[i, WALL_PUSH], work[i, WALL_MOMENT], obstacles_virial = wall_pushes(
             i, corrected, pushed, walls, obstacles, box, wall_params, n_axes)  # fmt: skip
-    kept[i, CROWD] = work[i, CONTACT] + pressing
+    crowd = work[i, CONTACT] + pressing
+    kept[i, WEIGHT] = 1.0 / max(1.0, crowd)
     if not first:  # the neighbours present at the start are not encounters
         gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
     kept[i, NEAR_BEFORE] = work[i, NEAR]
     if gas.rate > 0.0 and gas.target2[0] > 0.0:
-        _thermostat(i, known, setpoint, pushed, work, kept, contacts, gas.mean, gas.rate, gas.target2[0], gas.inv_g,
+        _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, gas.mean, gas.rate, gas.target2[0], gas.inv_g,
                     gas.energy_scale, n_axes)  # fmt: skip
     if walls[0] > 0.0:  # the virial of every push but the walls', about the box's centre (G1)
         own = 0.0
@@ -354,6 +360,8 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
     rms = thermostat.rms_velocity if thermostat is not None else None
     tau = thermostat.tau if thermostat is not None else ThermostatParams().tau
     dt = scenario.simulation.dt
+    kept = np.zeros((size, 6))
+    kept[:, WEIGHT] = 1.0  # no contacts yet
     return Gas(
         observe=observe,
         mean=scenario.interaction.combine == "mean",
@@ -369,7 +377,7 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         c_max=scenario.interaction.c_max,
         first=np.ones(1, dtype=np.bool_),
         work=np.zeros((size, 6)),
-        kept=np.zeros((size, 6)),
+        kept=kept,
         pushed=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),
     )
