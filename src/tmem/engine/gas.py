@@ -116,9 +116,9 @@ def pair_share(i, j, kept):
 
 
 @numba.njit(cache=True, inline="always")
-def add_contact(i, j, near, pressing, virial, work):
+def add_contact(i, j, near, pressing, virial, pair_virial, work):
     """Count the pair ``(i, j)`` for both agents: whether it is within reach, its push's squared size
-    over ``c_max^2`` and the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
+    over ``c_max^2`` and, when ``pair_virial``, the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
 
     Parameters
     ----------
@@ -130,6 +130,8 @@ def add_contact(i, j, near, pressing, virial, work):
         The pair's push's squared size over ``c_max^2``.
     virial : float
         ``(P_i - P_j) . u_ij``, the push on ``i`` as applied.
+    pair_virial : bool
+        Whether the virial is the pairs' (G1): in a periodic box, not a walled one.
     work : ndarray
         ``Gas.work``, changed in place.
     """
@@ -137,8 +139,9 @@ def add_contact(i, j, near, pressing, virial, work):
     work[j, NEAR] += near
     work[i, CONTACT] += pressing
     work[j, CONTACT] += pressing
-    work[i, VIRIAL] += virial
-    work[j, VIRIAL] += virial
+    if pair_virial:
+        work[i, VIRIAL] += virial
+        work[j, VIRIAL] += virial
 
 
 @numba.njit(cache=True, inline="always")

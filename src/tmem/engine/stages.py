@@ -280,11 +280,12 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
     """Add a chunk's pushes to ``u`` as :func:`_pushes_of` does, for the gas (:mod:`tmem.engine.gas`):
     under the mean of pushes (C1) each push divided by :func:`tmem.engine.gas.pair_share`, and each
     pair within reach counted for both its agents (:func:`tmem.engine.gas.add_contact`), in one
-    pass.  A pair beyond reach adds zeros rather than being skipped: whether a listed pair is within
+    pass; in a periodic box, each pair's virial too (G1).  A pair beyond reach adds zeros rather than being skipped: whether a listed pair is within
     reach is a coin toss the processor cannot predict, and the branch cost more than the adds."""
     work = gas.work
     kept = gas.kept
     mean = gas.mean
+    pair_virial = gas.walls[0] == 0.0  # a walled box takes each agent's virial about its centre instead
     inv_c_max2 = 1.0 / (gas.c_max * gas.c_max)
     for t in range(m):
         i = pairs[begin + t, 0]
@@ -298,8 +299,10 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
             push = chunks[w, a, t] * share
             u[i, a] += push
             u[j, a] -= push
-            virial -= chunks[w, n_axes + a, t] * push
-        add_contact(i, j, 1.0 if chunks[w, 2 * n_axes, t] < np.inf else 0.0, size2 * inv_c_max2, virial, work)
+            if pair_virial:
+                virial -= chunks[w, n_axes + a, t] * push
+        add_contact(i, j, 1.0 if chunks[w, 2 * n_axes, t] < np.inf else 0.0, size2 * inv_c_max2, virial, pair_virial,
+                    work)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
