@@ -1,12 +1,12 @@
 """Throughput of the gas-N case with the gas's options on, against the plain gas-N, in one run.
 
 The plain case is benchmarks/bench_gas.py's gas-N (2-D periodic box, six neighbours within
-R + R_j on average, repulsion, dt = 0.01 s, 1000 steps, nothing recorded).  The case with the
-options puts the same agents in a walled box of the same side, holds them at their 3 m/s with the
-thermostat and averages their pushes (``interaction.combine = "mean"``), which turns on every gas
-stage: the neighbour counts, walls, thermostat and running totals.  The two alternate, after one
-compile run each; each figure is the median of ``--repeat`` runs, in agent-steps per second, and the
-ratio is that of the medians.
+R + R_j on average, repulsion, dt = 0.01 s, 1000 steps, nothing recorded).  The cases with options
+put the same agents in a walled box of the same side and hold them at their 3 m/s with the
+thermostat, which turns on every gas stage: the neighbour counts, walls, thermostat and running
+totals; the last also averages their pushes (``interaction.combine = "mean"``).  The cases
+alternate, after one compile run each; each figure is the median of ``--repeat`` runs, in
+agent-steps per second, and each ratio is that of the medians.
 
 Usage::
 
@@ -28,11 +28,11 @@ import tmem
 from tmem.scenario import with_changes
 
 
-def with_options(n: int, steps: int = STEPS):
-    """gas-N in a walled box with the thermostat and the mean of pushes."""
+def with_options(n: int, *, mean: bool, steps: int = STEPS):
+    """gas-N in a walled box with the thermostat, and the mean of pushes if ``mean``."""
     plain = gas(n, steps)
-    return with_changes(plain, {"space.periodic": False, "space.walls": True, "interaction.combine": "mean",
-                                "thermostat": {"rms_velocity": 3.0}})  # fmt: skip
+    return with_changes(plain, {"space.periodic": False, "space.walls": True, "thermostat": {"rms_velocity": 3.0},
+                                "interaction.combine": "mean" if mean else "sum"})  # fmt: skip
 
 
 def main() -> None:
@@ -43,7 +43,8 @@ def main() -> None:
     args = parser.parse_args()
     rows = []
     for n in args.n:
-        cases = {"plain": gas(n), "walls + thermostat + mean": with_options(n)}
+        cases = {"plain": gas(n), "walls + thermostat": with_options(n, mean=False),
+                 "walls + thermostat + mean": with_options(n, mean=True)}  # fmt: skip
         for scenario in cases.values():  # compile, or load from the cache
             tmem.simulate(with_changes(scenario, {"simulation.duration": 5 * DT, "simulation.record_every": 5}), record=False)
         seconds = {name: [] for name in cases}
@@ -53,11 +54,12 @@ def main() -> None:
                 tmem.simulate(scenario, record=False)
                 seconds[name].append(time.perf_counter() - start)
         rates = {name: n * STEPS / statistics.median(s) for name, s in seconds.items()}
-        ratio = rates["walls + thermostat + mean"] / rates["plain"]
+        ratios = {name: rate / rates["plain"] for name, rate in rates.items() if name != "plain"}
         for name, rate in rates.items():
             print(f"N = {n:>8}  {name:<28} {rate:.3g} agent-steps/s  (runs: {', '.join(f'{s:.2f}' for s in seconds[name])} s)")
-        print(f"N = {n:>8}  ratio (options / plain): {ratio:.3f}")
-        rows.append({"n": n, "rates": rates, "seconds": seconds, "ratio": ratio})
+        for name, ratio in ratios.items():
+            print(f"N = {n:>8}  ratio ({name} / plain): {ratio:.3f}")
+        rows.append({"n": n, "rates": rates, "seconds": seconds, "ratios": ratios})
     if args.json:
         args.json.write_text(json.dumps({"machine": platform.platform(), "repeat": args.repeat, "rows": rows}, indent=1))
 
