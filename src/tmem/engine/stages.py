@@ -280,8 +280,9 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
     """Add a chunk's pushes to ``u`` as :func:`_pushes_of` does, for the gas (:mod:`tmem.engine.gas`):
     under the mean of pushes (C1) each push divided by :func:`tmem.engine.gas.pair_share`, and each
     pair within reach counted for both its agents (:func:`tmem.engine.gas.add_contact`), in one
-    pass; in a periodic box, each pair's virial too (G1).  A pair beyond reach adds zeros rather than being skipped: whether a listed pair is within
-    reach is a coin toss the processor cannot predict, and the branch cost more than the adds."""
+    pass; in a periodic box, each pair's virial too (G1).  A pair beyond reach adds zeros rather
+    than being skipped: whether a listed pair is within reach is a coin toss the processor cannot
+    predict, and the branch cost more than the adds."""
     work = gas.work
     kept = gas.kept
     mean = gas.mean
