@@ -7,7 +7,8 @@ the compiled loop runs it (:mod:`tmem.engine.loop`)::
              -> record -> saturate |U| <= c_max -> the vehicle's step over dt
 
 * :mod:`tmem.engine.records` — the named records the stages work on;
-* :mod:`tmem.engine.stages` — one compiled function per stage;
+* :mod:`tmem.engine.stages` — one compiled function per stage; the neighbour pushes in
+  :mod:`tmem.engine.pushes`;
 * :mod:`tmem.engine.loop` — the loop, compiled once per vehicle model;
 * :mod:`tmem.engine.driver` — builds the records from a scenario and drives the loop;
 * :mod:`tmem.engine.checkpoint` — a run's state saved at checkpoints, and the run resumed from one;

@@ -30,7 +30,7 @@ from ..scenario.sensing_table import SensingParams
 from ..sensing import exact, sensing_of
 from .checkpoint import Checkpoints, Saved, restore
 from .loop import advance_for
-from .stages import CHUNK
+from .pushes import CHUNK
 from .gas import SNAPSHOT, TOTALS, gas_record
 from .law import law_of
 from .records import (

@@ -116,6 +116,19 @@ def pair_share(i, j, kept):
 
 
 @numba.njit(cache=True, inline="always")
+def virial_by_pairs(walls):
+    """Whether the virial (G1) is summed pair by pair, ``(P_i - P_j) . u_ij``: in a box without walls.
+    A walled box takes each agent's ``(P_i - c) . u_i`` about its centre ``c`` instead.
+
+    Parameters
+    ----------
+    walls : ndarray, shape (axes,)
+        ``Gas.walls``: the walled box's sides, 0 without walls.
+    """
+    return walls[0] == 0.0
+
+
+@numba.njit(cache=True, inline="always")
 def add_contact(i, j, near, pressing, virial, pair_virial, work):
     """Count the pair ``(i, j)`` for both agents: whether it is within reach, its push's squared size
     over ``c_max^2`` and, when ``pair_virial``, the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
@@ -156,7 +169,8 @@ def _stiffness(near, crowd, mean):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, mean, rate, target2, inv_g, energy_scale, n_axes):
+def _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, mean, rate, target2, inv_g, energy_scale,
+                n_axes):
     """Add agent ``i``'s thermostat push (T1) along its velocity, from its estimate of the
     temperature (T2): its ``|V|^2`` and the energy its pushes hold now, less what they hold on average."""
     pushed2 = 0.0
@@ -196,9 +210,9 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
         gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
     kept[i, NEAR_BEFORE] = work[i, NEAR]
     if gas.rate > 0.0 and gas.target2[0] > 0.0:
-        _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, gas.mean, gas.rate, gas.target2[0], gas.inv_g,
-                    gas.energy_scale, n_axes)  # fmt: skip
-    if walls[0] > 0.0:  # the virial of every push but the walls', about the box's centre (G1)
+        _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, gas.mean, gas.rate, gas.target2[0],
+                    gas.inv_g, gas.energy_scale, n_axes)  # fmt: skip
+    if not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
         own = 0.0
         for a in range(n_axes):
             own += (corrected[i, a, 1] - 0.5 * walls[a]) * setpoint[i, a]
@@ -245,10 +259,10 @@ def _gas_block(begin, end, known, agents, gas, wall_params, box, first):
     """Agents ``begin:end`` of :func:`gas_pushes`, one after the other.
 
     Called, not inlined, once per block of agents: compiled once, the gas's code stays out of the
-    step loop's compilation, and out of Numba's transform of the parallel loop, which moved constant
-    assignments of the inlined agent's code out of the loop and gave the threaded loop other totals
-    than the serial one.  A call per agent cost more than the agent's work (its records passed each
-    time); a call per block costs nothing."""
+    step loop's compilation, and out of Numba's transform of the parallel loop.  Inlined in the
+    parallel loop, the agent's code gave the threaded loop other totals than the serial one (Numba's
+    diagnostics show constant assignments of that code moved out of the loop).  A call per agent
+    cost more than the agent's work (its records passed each time); a call per block costs nothing."""
     for i in range(begin, end):
         if agents.active[i]:
             _gas_agent(i, known, agents.corrected, agents.setpoint, gas, wall_params, box, first)

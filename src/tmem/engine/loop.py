@@ -34,7 +34,8 @@ from ..control import tilt_scale
 from .gas import gas_pushes, tally, tilt_limit
 from .pairs import formation_pairs
 from .sensed import sensed_formation_pairs, sensed_neighbour_pushes
-from .stages import apply_commands, commands_due, corrected_positions, is_recorded, neighbour_pushes, record
+from .pushes import neighbour_pushes
+from .stages import apply_commands, commands_due, corrected_positions, is_recorded, record
 
 #: Whether the loop takes the sensed path (:mod:`tmem.engine.sensed`); bound for each compiled copy by
 #: :func:`advance_for`.  Numba prunes the branch not taken before it types the loop, so the exact

@@ -15,7 +15,7 @@ from .. import coupling
 from ..interaction.kernels import FunctionParams, pair_control
 from ..space import nearest_image
 from ..synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
-from .gas import add_contact, pair_share
+from .gas import add_contact, pair_share, virial_by_pairs
 from .stages import log_event
 
 
@@ -266,7 +266,7 @@ def _count_pair(e, agents, pairs, law, params, box, gas):
     virial = 0.0
     for a in range(n_axes):
         virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
-    add_contact(i, j, 1.0, pressing, virial, gas.walls[0] == 0.0, gas.work)
+    add_contact(i, j, 1.0, pressing, virial, virial_by_pairs(gas.walls), gas.work)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")

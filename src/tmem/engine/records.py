@@ -190,7 +190,7 @@ class Neighbours(NamedTuple):
         Work space: the largest squared shift of ``P*`` since ``p_ref`` in each block of agents this step.
     closest : ndarray, shape (1,)
         Smallest squared distance of two agents within reach so far.
-    chunks : ndarray, shape (blocks + 1, 2 axes + 1, CHUNK)
+    chunks : ndarray, shape (blocks + 1, 2 axes + 1, :data:`tmem.engine.pushes.CHUNK`)
         Work space: the chunk of pairs each block sums (the last row: the pairs between blocks).
     """
 
@@ -274,7 +274,7 @@ class Gas(NamedTuple):
         rows.
     kept : ndarray, shape (agents, 6)
         What each agent keeps from step to step (:data:`tmem.engine.gas.NEAR_BEFORE` ...
-        :data:`tmem.engine.gas.STEPS`), among them its contacts, which it broadcasts (C1).
+        :data:`tmem.engine.gas.STEPS`), among them the weight of its pushes, which it broadcasts (C1).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)

@@ -5,7 +5,7 @@ differs from what ``k`` knows of ``j``, so a pair's two pushes are no longer
 equal and opposite: each receiver evaluates its own, from ``d = P*_other -
 P*_own``, its neighbour's ``P*`` (6) as it measures it and its own as it
 measures itself.  These stages take the place of
-:func:`tmem.engine.stages.neighbour_pushes` and
+:func:`tmem.engine.pushes.neighbour_pushes` and
 :func:`tmem.engine.pairs.formation_pairs` in the loop's sensed copy
 (:func:`tmem.engine.loop.advance_for`); the exact path is compiled without
 them, as before.
@@ -84,7 +84,7 @@ def sensed_neighbour_pushes(k, agents, neighbours, law, params, run, sensing):
     """Every listed non-formation pair's pushes, each agent's from its own measurement (module text).
 
     The blocks of :func:`tmem.neighbors.arrange` run on threads, then the pairs between them, as in
-    :func:`tmem.engine.stages.neighbour_pushes`.
+    :func:`tmem.engine.pushes.neighbour_pushes`.
 
     Parameters
     ----------

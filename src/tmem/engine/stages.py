@@ -10,8 +10,10 @@ work space comes in the records.
    sensed path, :mod:`tmem.engine.sensed`, takes the place of steps 4 and 5);
 3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
    lists have drifted;
-4. :func:`neighbour_pushes` — the pushes of the non-formation neighbours;
+4. :func:`tmem.engine.pushes.neighbour_pushes` — the pushes of the non-formation neighbours;
 5. :func:`tmem.engine.pairs.formation_pairs` — each pair's flag ``F_en`` and its pull or push;
+   then, when the gas is observed, :func:`tmem.engine.gas.gas_pushes` — thermostat, walls and
+   obstacles;
 6. :func:`record` — the recorded step;
 7. combining and saturating the set-point (:func:`tmem.control.tilt_scale`) and the
    vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
@@ -28,14 +30,9 @@ import numpy as np
 
 from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
 from ..control import corrected_by, gains_of, tilt_scale
-from ..interaction.kernels import FunctionParams, push_factor
 from ..space import nearest_image
-from .gas import add_contact, clear, pair_share, record_totals, tilt_limit
+from .gas import clear, record_totals, tilt_limit
 from .records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
-
-#: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
-CHUNK = 256
-
 
 @numba.njit(cache=True, inline="always")
 def log_event(events, counters, k, kind, i, j, action, rule):
@@ -217,133 +214,6 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
     for b in range(n_blocks):
         moved = max(moved, block_shift2[b])
     return moved
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _chunk_pushes(chunks, w, m, n_axes, function, params):
-    """The pushes of ``m`` pairs, in place in the work space ``chunks[w]``: row ``a`` holds
-    ``d_a = P*_j - P*_i`` on entry and the push on agent ``i`` along axis ``a``, ``f(|d|) d_a / |d|``,
-    on return (0 beyond reach).  Row ``n_axes + a`` holds ``P_j - P_i``; row ``2 n_axes`` gets
-    ``|P_j - P_i|^2`` for the pairs within reach, ``inf`` for the others.  No branches: the compiler
-    vectorises it."""
-    reach2 = params.reach * params.reach
-    for t in range(m):
-        r2 = 0.0
-        for a in range(n_axes):
-            r2 += chunks[w, a, t] * chunks[w, a, t]
-        inside = (r2 < reach2) & (r2 > 0.0)
-        push = push_factor(function, r2, params)
-        dist2 = 0.0
-        for a in range(n_axes):
-            dist2 += chunks[w, n_axes + a, t] * chunks[w, n_axes + a, t]
-            chunks[w, a, t] *= push
-        chunks[w, 2 * n_axes, t] = dist2 if inside else np.inf
-
-
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, w, gas):
-    """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
-    the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
-    the work space.  When the gas is observed, count each agent's neighbours within reach, the sum of
-    their ``|V|^2`` and the virial of the pushes (:class:`tmem.engine.records.Gas`).
-
-    Called, not inlined: the loop calls it from two places, and each inlined copy of it (with the
-    interaction functions inside) cost two seconds of the first run's compilation.  The call costs
-    nanoseconds against the chunks of pairs it sums; the loop skips it when there are no pairs."""
-    n_axes = len(box)
-    nearest2 = np.inf
-    for begin in range(first, stop, CHUNK):
-        m = min(CHUNK, stop - begin)
-        for t in range(m):
-            i = pairs[begin + t, 0]
-            j = pairs[begin + t, 1]
-            for a in range(n_axes):
-                chunks[w, a, t] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
-                chunks[w, n_axes + a, t] = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
-        _chunk_pushes(chunks, w, m, n_axes, function, params)
-        for t in range(m):
-            nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
-        if gas.observe:
-            _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas)
-            continue
-        for t in range(m):
-            i = pairs[begin + t, 0]
-            j = pairs[begin + t, 1]
-            for a in range(n_axes):
-                u[i, a] += chunks[w, a, t]
-                u[j, a] -= chunks[w, a, t]
-    return nearest2
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
-    """Add a chunk's pushes to ``u`` as :func:`_pushes_of` does, for the gas (:mod:`tmem.engine.gas`):
-    under the mean of pushes (C1) each push divided by :func:`tmem.engine.gas.pair_share`, and each
-    pair within reach counted for both its agents (:func:`tmem.engine.gas.add_contact`), in one
-    pass; in a periodic box, each pair's virial too (G1).  A pair beyond reach adds zeros rather
-    than being skipped: whether a listed pair is within reach is a coin toss the processor cannot
-    predict, and the branch cost more than the adds."""
-    work = gas.work
-    kept = gas.kept
-    mean = gas.mean
-    pair_virial = gas.walls[0] == 0.0  # a walled box takes each agent's virial about its centre instead
-    inv_c_max2 = 1.0 / (gas.c_max * gas.c_max)
-    for t in range(m):
-        i = pairs[begin + t, 0]
-        j = pairs[begin + t, 1]
-        size2 = 0.0
-        for a in range(n_axes):
-            size2 += chunks[w, a, t] * chunks[w, a, t]
-        share = pair_share(i, j, kept) if mean else 1.0
-        virial = 0.0
-        for a in range(n_axes):
-            push = chunks[w, a, t] * share
-            u[i, a] += push
-            u[j, a] -= push
-            if pair_virial:
-                virial -= chunks[w, n_axes + a, t] * push
-        add_contact(i, j, 1.0 if chunks[w, 2 * n_axes, t] < np.inf else 0.0, size2 * inv_c_max2, virial, pair_virial,
-                    work)  # fmt: skip
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def neighbour_pushes(agents, neighbours, law, params, run, gas):
-    """Sum the pushes of every listed non-formation pair within reach, ``f(|d|)`` along ``d / |d|``.
-
-    (Parallel loops take plain arrays and numbers: the records' fields are read out before them.)
-    Each block's own pairs run on a thread of their own, then the pairs crossing between blocks, so
-    every agent adds its pushes in one order whatever the number of threads.  ``f`` is the
-    function of :attr:`Law.neighbour_function`, with the scenario's ``d_t``.
-
-    Parameters
-    ----------
-    agents, neighbours, law, run, gas
-        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``neighbours`` and ``gas`` change
-        in place.
-    params : FunctionParams
-        The interaction functions' parameters.
-    """
-    box = run.box
-    function = law.neighbour_function
-    corrected = agents.corrected
-    setpoint = agents.setpoint
-    pairs = neighbours.pairs
-    block_ptr = neighbours.block_ptr
-    block_nearest2 = neighbours.block_nearest2
-    chunks = neighbours.chunks
-    n_blocks = block_ptr.shape[0] - 1
-    for b in numba.prange(n_blocks):
-        block_nearest2[b] = np.inf
-        if block_ptr[b + 1] > block_ptr[b]:
-            block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params,
-                                           setpoint, chunks, b, gas)  # fmt: skip
-    nearest2 = np.inf
-    if neighbours.n_pairs > neighbours.n_inside:
-        nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint,
-                              chunks, n_blocks, gas)  # fmt: skip
-    for b in range(n_blocks):
-        nearest2 = min(nearest2, block_nearest2[b])
-    neighbours.closest[0] = min(neighbours.closest[0], nearest2)
 
 
 @numba.njit(cache=True, inline="always")
