@@ -229,4 +229,18 @@ def tilt_scale(u, i, n_axes, c_max):
     norm2 = 0.0
     for a in range(n_axes):
         norm2 += u[i, a] * u[i, a]
+    return saturation(norm2, c_max)
+
+
+@numba.njit(cache=True, inline="always")
+def saturation(norm2, c_max):
+    """The factor that brings a set-point of squared norm ``norm2`` within ``c_max``: 1 if it is.
+
+    Parameters
+    ----------
+    norm2 : float
+        The set-point's squared norm (rad^2).
+    c_max : float
+        Tilt limit (rad).
+    """
     return c_max / np.sqrt(norm2) if norm2 > c_max * c_max else 1.0

@@ -75,7 +75,7 @@ REBUILT = {
         "block_nearest2": _WORK, "block_shift2": _WORK, "chunks": _WORK,
     },
     "gas": {
-        **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "wall_reach", "energy_scale", "c_max"), _FIXED),
+        **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "wall_reach", "c_max"), _FIXED),
         "work": _WORK, "pushed": _WORK,
     },
     "sensing": {
@@ -89,7 +89,7 @@ ROWS = {
     **{("events", f): "n_events" for f in Events._fields},
 }
 #: Raised to the checkpoint's file format when it changes.
-FORMAT = 3
+FORMAT = 4
 
 
 class CheckpointError(ValueError):

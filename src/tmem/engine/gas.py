@@ -13,12 +13,14 @@ The derivations are in ``docs/gas.md``; equation labels below refer to it.
   ``c_max`` (from 0 at the edge of reach to 1 at saturation), so that a neighbour coming within
   reach changes the weights smoothly: counted whole at once, each arrival would jolt the others'
   pushes.  With one neighbour nothing changes.
-* **Thermostat (T1)-(T2).**  Each agent estimates the temperature from its own state (T2): its
-  ``|V|^2``, plus the energy its pushes hold, ``S_i = (g |U| / omega)^2`` with ``omega`` its slow
-  mode's frequency, less the share of ``T*`` its pushes have held on average since the start.  An
-  encounter reads as warm as it is, and the swarm's kinetic energy, the RMS velocity, is what is
-  held.  It tilts along its velocity so that ``dV/dt = (T* / T_i - 1) V / (2 tau)``: Berendsen's
-  weak coupling, applied per agent.
+* **Thermostat (T1), (T3).**  A free agent tilts along its velocity so that
+  ``dV/dt = (T* / |V|^2 - 1) V / (2 tau)``: Berendsen's weak coupling, applied per agent (T1).  An
+  agent in contact with neighbours heats or cools only the common motion of itself and them (T3):
+  it accelerates along ``V_c``, the mean of its velocity and its neighbours', so that the mean
+  ``|V|^2`` of the group relaxes to ``T*`` at Berendsen's rate.  A pair meeting gets the same push
+  on both agents, so their relative motion, the encounter, is exactly the one without a
+  thermostat: the energy an encounter holds for a while is made up while it holds it, and two
+  agents meeting head-on are never driven into each other.
 * **Walls and obstacles (W1)-(W2)** are neighbours held still, with the last word on the
   set-point: :mod:`tmem.engine.walls`.
 
@@ -33,6 +35,7 @@ import numpy as np
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from ..scenario import ThermostatParams
 from ..space import nearest_image
+from ..control import saturation
 from .records import Gas
 from .walls import keep_off, wall_pushes, with_priority
 
@@ -61,14 +64,19 @@ WALL_MOMENTUM, WALL_VIRIAL, VIRIAL_TOTAL, ENCOUNTERS, PATH, BREACHES = range(len
 #: the virial theorem's boundary term, m^2/s).
 SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
 #: Columns of ``Gas.work``, one row per agent, cleared at each step: neighbours within reach, their
-#: pushes' squared sizes over ``c_max^2``, the agent's virial (rad m), its ``|V|^2``, the size of the
-#: box walls' pushes (rad) and their moment about the walls (rad m).
-NEAR, CONTACT, VIRIAL, SPEED2, WALL_PUSH, WALL_MOMENT = range(6)
+#: pushes' squared sizes over ``c_max^2`` (its contacts), the agent's virial (rad m), its ``|V|^2``,
+#: the size of the box walls' pushes (rad) and their moment about the walls (rad m), then its
+#: neighbours' ``|V|^2`` and, from :data:`NEIGHBOUR_VELOCITY` on, one column per axis, their
+#: velocities, each neighbour weighted by its contact (T3).
+NEAR, CONTACT, VIRIAL, SPEED2, WALL_PUSH, WALL_MOMENT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY = range(8)
 #: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
-#: step before, the weight of its pushes at the step before, ``1 / max(1, contacts)`` (C1), the energy
-#: its pushes held (T2), its tilt limit, the mean share of ``T*`` its pushes held over the steps of the
-#: thermostat (T2), and those steps.
-NEAR_BEFORE, WEIGHT, STORED, LIMIT, SHARE, STEPS = range(6)
+#: step before, the weight of its pushes at the step before, ``1 / max(1, contacts)`` (C1), and its
+#: tilt limit.
+NEAR_BEFORE, WEIGHT, LIMIT = range(3)
+#: The common velocity's square is counted as at least this share of the group's mean ``|V|^2`` (T3):
+#: a pair meeting head-on has no common motion to heat, and is left as it is, not pushed hard along
+#: a direction that round-off sets.
+COMMON_FLOOR = 0.25
 
 
 @numba.njit(cache=True, inline="always")
@@ -129,9 +137,10 @@ def virial_by_pairs(walls):
 
 
 @numba.njit(cache=True, inline="always")
-def add_contact(i, j, near, pressing, virial, pair_virial, work):
+def add_contact(i, j, near, pressing, virial, pair_virial, work, known):
     """Count the pair ``(i, j)`` for both agents: whether it is within reach, its push's squared size
-    over ``c_max^2`` and, when ``pair_virial``, the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
+    over ``c_max^2``, the other's ``|V|^2`` and velocity weighted by it (T3) and, when ``pair_virial``,
+    the pair's virial ``(P_i - P_j) . u_ij`` (rad m).
 
     Parameters
     ----------
@@ -146,44 +155,68 @@ def add_contact(i, j, near, pressing, virial, pair_virial, work):
     pair_virial : bool
         Whether the virial is the pairs' (G1): in a periodic box, not a walled one.
     work : ndarray
-        ``Gas.work``, changed in place.
+        ``Gas.work``, changed in place; both agents' ``|V|^2`` already in it (:func:`clear`).
+    known : ndarray, shape (agents, axes, n_state)
+        The states as known: the true ones, since the gas's stages run only where sensing is exact.
     """
     work[i, NEAR] += near
     work[j, NEAR] += near
     work[i, CONTACT] += pressing
     work[j, CONTACT] += pressing
+    work[i, NEIGHBOUR_SPEED2] += pressing * work[j, SPEED2]
+    work[j, NEIGHBOUR_SPEED2] += pressing * work[i, SPEED2]
+    for a in range(known.shape[1]):
+        work[i, NEIGHBOUR_VELOCITY + a] += pressing * known[j, a, 1]
+        work[j, NEIGHBOUR_VELOCITY + a] += pressing * known[i, a, 1]
     if pair_virial:
         work[i, VIRIAL] += virial
         work[j, VIRIAL] += virial
 
 
 @numba.njit(cache=True, inline="always")
-def _stiffness(near, crowd, mean):
-    """``omega^2 / im_r^2`` of the slow mode an agent with ``near`` neighbours and ``crowd`` contacts
-    oscillates in (T2): 1 against walls alone (``A - B K``), 2 for a pair (``A - 2 B K``, within 3 %),
-    ``w + 1 / near`` in general with ``w`` its summed weights, 1 under the mean of pushes, else
-    ``crowd``."""
-    if near == 0.0:
-        return max(1.0, crowd)
-    return (1.0 if mean else crowd) + 1.0 / near
+def _common(i, a, known, work, per_contact):
+    """Along axis ``a``, the velocity of the group of agent ``i`` (T3): half its own, half the mean of
+    its neighbours' weighted by their contacts."""
+    return 0.5 * (known[i, a, 1] + work[i, NEIGHBOUR_VELOCITY + a] * per_contact)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, mean, rate, target2, inv_g, energy_scale,
-                n_axes):
-    """Add agent ``i``'s thermostat push (T1) along its velocity, from its estimate of the
-    temperature (T2): its ``|V|^2`` and the energy its pushes hold now, less what they hold on average."""
-    pushed2 = 0.0
+def _thermostat(i, known, setpoint, work, kept, rate, target2, inv_g, c_max, n_axes):
+    """Add agent ``i``'s thermostat push: Berendsen's on its own velocity while free (T1), on the
+    common motion of itself and its neighbours while in contact (T3), blended by its contacts (their
+    pushes' squared sizes over ``c_max^2``, up to 1).  The pushes summed before are saturated at
+    ``c_max`` first, and the thermostat's push on its own: a pair's two agents, whose pushes are
+    equal and opposite, keep them so, and the tilt may reach ``2 c_max``.
+
+    The group is half the agent, half the mean of its neighbours weighted by their contacts: the two
+    agents of a pair find the same common velocity ``V_c = (V_i + V_j) / 2`` and mean square speed
+    ``T = (|V_i|^2 + |V_j|^2) / 2``, and are pushed alike, ``dV/dt = (T* - T) V_c / (2 tau q)`` with
+    ``q = max(|V_c|^2, T / 4)`` (:data:`COMMON_FLOOR`), so that ``dT/dt = (T* - T) / tau`` while
+    ``|V_c|^2 >= T / 4``."""
+    speed2 = work[i, SPEED2]
+    contact = work[i, CONTACT]
+    together = min(1.0, contact)
+    own = (1.0 - together) * rate * (target2 / speed2 - 1.0) * inv_g if speed2 > 0.0 else 0.0
+    per_contact = 1.0 / contact if contact > 0.0 else 0.0
+    group2 = 0.5 * (speed2 + work[i, NEIGHBOUR_SPEED2] * per_contact)
+    common2 = 0.0
     for a in range(n_axes):
-        total = setpoint[i, a] + (pushed[i, a] if contacts > 0 else 0.0)
-        pushed2 += total * total
-    kept[i, STORED] = energy_scale * pushed2 / _stiffness(work[i, NEAR], crowd, mean)
-    kept[i, STEPS] += 1.0
-    kept[i, SHARE] += (kept[i, STORED] / target2 - kept[i, SHARE]) / kept[i, STEPS]
-    temperature = work[i, SPEED2] + kept[i, STORED] - kept[i, SHARE] * target2
-    push = rate * (target2 / temperature - 1.0) * inv_g if temperature > 0.0 else 0.0
+        common2 += _common(i, a, known, work, per_contact) ** 2
+    floor2 = max(common2, COMMON_FLOOR * group2)
+    common = together * rate * (target2 - group2) * inv_g / floor2 if floor2 > 0.0 else 0.0
+    pushes2 = 0.0
+    push2 = 0.0
     for a in range(n_axes):
-        setpoint[i, a] += push * known[i, a, 1]
+        pushes2 += setpoint[i, a] * setpoint[i, a]
+        push2 += (own * known[i, a, 1] + common * _common(i, a, known, work, per_contact)) ** 2
+    pushes_scale = saturation(pushes2, c_max)
+    push_scale = saturation(push2, c_max)
+    tilt2 = 0.0
+    for a in range(n_axes):
+        setpoint[i, a] = pushes_scale * setpoint[i, a] + push_scale * (
+            own * known[i, a, 1] + common * _common(i, a, known, work, per_contact))
+        tilt2 += setpoint[i, a] * setpoint[i, a]
+    kept[i, LIMIT] = max(c_max, np.sqrt(tilt2))
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -210,8 +243,7 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
         gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
     kept[i, NEAR_BEFORE] = work[i, NEAR]
     if gas.rate > 0.0 and gas.target2[0] > 0.0:
-        _thermostat(i, known, setpoint, pushed, work, kept, contacts, crowd, gas.mean, gas.rate, gas.target2[0],
-                    gas.inv_g, gas.energy_scale, n_axes)  # fmt: skip
+        _thermostat(i, known, setpoint, work, kept, gas.rate, gas.target2[0], gas.inv_g, gas.c_max, n_axes)
     if not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
         own = 0.0
         for a in range(n_axes):
@@ -377,7 +409,7 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
     rms = thermostat.rms_velocity if thermostat is not None else None
     tau = thermostat.tau if thermostat is not None else ThermostatParams().tau
     dt = scenario.simulation.dt
-    kept = np.zeros((size, 6))
+    kept = np.zeros((size, 3))
     kept[:, WEIGHT] = 1.0  # no contacts yet
     return Gas(
         observe=observe,
@@ -390,10 +422,9 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         walls=walls,
         obstacles=obstacles,
         wall_reach=scenario.wall_reach,
-        energy_scale=(acceleration_per_tilt / scenario.controller.im_r) ** 2,
         c_max=scenario.interaction.c_max,
         first=np.ones(1, dtype=np.bool_),
-        work=np.zeros((size, 6)),
+        work=np.zeros((size, NEIGHBOUR_VELOCITY + space.axes)),
         kept=kept,
         pushed=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),

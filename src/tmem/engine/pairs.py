@@ -266,7 +266,7 @@ def _count_pair(e, agents, pairs, law, params, box, gas):
     virial = 0.0
     for a in range(n_axes):
         virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
-    add_contact(i, j, 1.0, pressing, virial, virial_by_pairs(gas.walls), gas.work)
+    add_contact(i, j, 1.0, pressing, virial, virial_by_pairs(gas.walls), gas.work, agents.state)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")

@@ -44,7 +44,7 @@ def _chunk_pushes(chunks, w, m, n_axes, function, params):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, w, gas):
+def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, chunks, w, gas):
     """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
     the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
     the work space.  When the gas is observed, count each agent's neighbours within reach, the sum of
@@ -67,7 +67,7 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, 
         for t in range(m):
             nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
         if gas.observe:
-            _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas)
+            _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known)
             continue
         for t in range(m):
             i = pairs[begin + t, 0]
@@ -79,7 +79,7 @@ def _pushes_of(corrected, pairs, first, stop, box, function, params, u, chunks, 
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
+def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known):
     """Add a chunk's pushes to ``u`` as :func:`_pushes_of` does, for the gas (:mod:`tmem.engine.gas`):
     under the mean of pushes (C1) each push divided by :func:`tmem.engine.gas.pair_share`, and each
     pair within reach counted for both its agents (:func:`tmem.engine.gas.add_contact`), in one
@@ -106,7 +106,7 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas):
             if pair_virial:
                 virial -= chunks[w, n_axes + a, t] * push
         add_contact(i, j, 1.0 if chunks[w, 2 * n_axes, t] < np.inf else 0.0, size2 * inv_c_max2, virial, pair_virial,
-                    work)  # fmt: skip
+                    work, known)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -129,6 +129,7 @@ def neighbour_pushes(agents, neighbours, law, params, run, gas):
     box = run.box
     function = law.neighbour_function
     corrected = agents.corrected
+    known = agents.state  # the gas's stages run only where sensing is exact
     setpoint = agents.setpoint
     pairs = neighbours.pairs
     block_ptr = neighbours.block_ptr
@@ -138,12 +139,12 @@ def neighbour_pushes(agents, neighbours, law, params, run, gas):
     for b in numba.prange(n_blocks):
         block_nearest2[b] = np.inf
         if block_ptr[b + 1] > block_ptr[b]:
-            block_nearest2[b] = _pushes_of(corrected, pairs, block_ptr[b], block_ptr[b + 1], box, function, params,
-                                           setpoint, chunks, b, gas)  # fmt: skip
+            block_nearest2[b] = _pushes_of(corrected, known, pairs, block_ptr[b], block_ptr[b + 1], box, function,
+                                           params, setpoint, chunks, b, gas)  # fmt: skip
     nearest2 = np.inf
     if neighbours.n_pairs > neighbours.n_inside:
-        nearest2 = _pushes_of(corrected, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params, setpoint,
-                              chunks, n_blocks, gas)  # fmt: skip
+        nearest2 = _pushes_of(corrected, known, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params,
+                              setpoint, chunks, n_blocks, gas)  # fmt: skip
     for b in range(n_blocks):
         nearest2 = min(nearest2, block_nearest2[b])
     neighbours.closest[0] = min(neighbours.closest[0], nearest2)

@@ -262,19 +262,17 @@ class Gas(NamedTuple):
         Centre and radius of each circle (sphere in 3-D).
     wall_reach : float
         ``R + R_w`` (m): a wall or obstacle pushes an agent whose ``P*`` is closer to it than that.
-    energy_scale : float
-        ``(g / im_r)^2``: the energy a push holds per rad^2 at the slow mode of ``A - B K`` (T2).
     c_max : float
         The scenario's tilt limit (rad).
     first : ndarray, shape (1,), bool
         True until the first step's neighbours are counted: they are not encounters.
-    work : ndarray, shape (agents, 6) (no rows when not observed)
+    work : ndarray, shape (agents, 7 + axes) (no rows when not observed)
         Each agent's work space of a step, in the columns :data:`tmem.engine.gas.NEAR` ...
-        :data:`tmem.engine.gas.WALL_MOMENT`: one row per agent, so that a pair's counts touch two
-        rows.
-    kept : ndarray, shape (agents, 6)
+        :data:`tmem.engine.gas.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's counts touch
+        two rows.
+    kept : ndarray, shape (agents, 3)
         What each agent keeps from step to step (:data:`tmem.engine.gas.NEAR_BEFORE` ...
-        :data:`tmem.engine.gas.STEPS`), among them the weight of its pushes, which it broadcasts (C1).
+        :data:`tmem.engine.gas.LIMIT`), among them the weight of its pushes, which it broadcasts (C1).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)
@@ -291,7 +289,6 @@ class Gas(NamedTuple):
     walls: np.ndarray
     obstacles: np.ndarray
     wall_reach: float
-    energy_scale: float
     c_max: float
     first: np.ndarray
     work: np.ndarray
