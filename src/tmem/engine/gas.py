@@ -6,25 +6,22 @@ The derivations are in ``docs/gas.md``; equation labels below refer to it.
 * **Mean of pushes (C1).**  An agent pushed by ``n`` neighbours held still sees the closed loop
   ``A - n B K``, whose slow pair leaves the imaginary axis for ``n != 1`` and grows for ``n >= 4``.
   With ``interaction.combine = "mean"`` the push of a pair is divided by the larger of its two
-  agents' contacts, as each broadcast them at the step before: pushes stay equal and opposite, and
+  agents' contacts, as each broadcast them at the last count: pushes stay equal and opposite, and
   no agent's gains add up to much more than one ``K``.  The modes of a crowd are then
   ``A - lambda B K`` with ``lambda`` in ``[0, 2]``, on which the slow pair stays within
   ``6e-6 / s`` of the imaginary axis.  A contact counts by the square of its push's size over
   ``c_max`` (from 0 at the edge of reach to 1 at saturation), so that a neighbour coming within
   reach changes the weights smoothly: counted whole at once, each arrival would jolt the others'
   pushes.  With one neighbour nothing changes.
-* **Thermostat (T1), (T3).**  A free agent tilts along its velocity so that
-  ``dV/dt = (T* / |V|^2 - 1) V / (2 tau)``: Berendsen's weak coupling, applied per agent (T1).  An
-  agent in contact with neighbours heats or cools only the common motion of itself and them (T3):
-  it accelerates along ``V_c``, the mean of its velocity and its neighbours', so that the mean
-  ``|V|^2`` of the group relaxes to ``T*`` at Berendsen's rate.  A pair meeting gets the same push
-  on both agents, so their relative motion, the encounter, is exactly the one without a
-  thermostat: the energy an encounter holds for a while is made up while it holds it, and two
-  agents meeting head-on are never driven into each other.
+* **Thermostat (T1), (T3)**: :mod:`tmem.engine.thermostat`.
 * **Walls and obstacles (W1)-(W2)** are neighbours held still, with the last word on the
   set-point: :mod:`tmem.engine.walls`.
 
-The running totals (per agent, summed at each record) are those of :data:`TOTALS`.
+The counts a pair adds to its agents (contacts, the thermostat's groups, the virial, encounters)
+are taken every ``simulation.gas_period`` (a *count*, ``Gas.every`` steps apart), and what they set
+is held between counts: the weights of the mean of pushes, the thermostat's group pushes.  The
+walls, the thermostat's free part and the momentum the walls take act at every step.  The running
+totals (per agent, summed at each record) are those of :data:`TOTALS`.
 """
 
 from __future__ import annotations
@@ -35,8 +32,10 @@ import numpy as np
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from ..scenario import ThermostatParams
 from ..space import nearest_image
-from ..control import saturation
+from .gas_columns import (CONTACT, NEAR, NEAR_BEFORE, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL, WALL_MOMENT,
+                          WALL_PUSH, COMMON, LIMIT, WEIGHT)  # fmt: skip
 from .records import Gas
+from .thermostat import add_thermostat_push, hold_group_push
 from .walls import keep_off, wall_pushes, with_priority
 
 #: Long name and units of each column of a record, per unit agent mass: first the running totals
@@ -54,34 +53,21 @@ COLUMNS = {
 }
 #: The running totals of each agent, the columns of ``Gas.totals``: momentum given to the box's walls
 #: (m/s), the same weighted by the agent's distance from the wall (m^2/s), the virial of the pushes
-#: integrated over time (m^2/s), encounters (neighbours that came within reach: the rises of the
-#: agent's count of them, step to step), path flown (m), and steps spent beyond a wall or inside an
-#: obstacle.
+#: integrated over time (m^2/s, sampled at the counts), encounters (neighbours that came within
+#: reach: the rises of the agent's count of them, count to count), path flown (m, sampled at the
+#: counts), and steps spent beyond a wall or inside an obstacle.
 TOTALS = tuple(COLUMNS)[:6]
 WALL_MOMENTUM, WALL_VIRIAL, VIRIAL_TOTAL, ENCOUNTERS, PATH, BREACHES = range(len(TOTALS))
 #: What a record holds besides the totals summed over agents: the sum of ``|V|^2`` of the flying
 #: agents, their number, and ``sum_i (P_i - c) . V_i`` over the walled axes (``c`` the box's centre;
 #: the virial theorem's boundary term, m^2/s).
 SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
-#: Columns of ``Gas.work``, one row per agent, cleared at each step: neighbours within reach, their
-#: pushes' squared sizes over ``c_max^2`` (its contacts), the agent's virial (rad m), its ``|V|^2``,
-#: the size of the box walls' pushes (rad) and their moment about the walls (rad m), then its
-#: neighbours' ``|V|^2`` and, from :data:`NEIGHBOUR_VELOCITY` on, one column per axis, their
-#: velocities, each neighbour weighted by its contact (T3).
-NEAR, CONTACT, VIRIAL, SPEED2, WALL_PUSH, WALL_MOMENT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY = range(8)
-#: Columns of ``Gas.kept``, one row per agent, kept from step to step: neighbours within reach at the
-#: step before, the weight of its pushes at the step before, ``1 / max(1, contacts)`` (C1), and its
-#: tilt limit.
-NEAR_BEFORE, WEIGHT, LIMIT = range(3)
-#: The common velocity's square is counted as at least this share of the group's mean ``|V|^2`` (T3):
-#: a pair meeting head-on has no common motion to heat, and is left as it is, not pushed hard along
-#: a direction that round-off sets.
-COMMON_FLOOR = 0.25
 
 
 @numba.njit(cache=True, inline="always")
-def clear(i, known, work, kept, c_max, n_axes):
-    """Start agent ``i``'s step: nothing counted yet; its own ``|V|^2`` as known.
+def clear(i, known, work, kept, c_max, n_axes, counting):
+    """Start agent ``i``'s step: its tilt limit ``c_max``; at a count, nothing counted yet and its own
+    ``|V|^2`` as known.
 
     Called in a parallel loop: it takes the record's arrays, not the record.
 
@@ -97,14 +83,18 @@ def clear(i, known, work, kept, c_max, n_axes):
         The scenario's tilt limit (rad).
     n_axes : int
         Number of axes.
+    counting : bool
+        Whether the step is a count.
     """
+    kept[i, LIMIT] = c_max
+    if not counting:
+        return
     speed2 = 0.0
     for a in range(n_axes):
         speed2 += known[i, a, 1] * known[i, a, 1]
     for c in range(work.shape[1]):
         work[i, c] = 0.0
     work[i, SPEED2] = speed2
-    kept[i, LIMIT] = c_max
 
 
 @numba.njit(cache=True, inline="always")
@@ -173,54 +163,8 @@ def add_contact(i, j, near, pressing, virial, pair_virial, work, known):
         work[j, VIRIAL] += virial
 
 
-@numba.njit(cache=True, inline="always")
-def _common(i, a, known, work, per_contact):
-    """Along axis ``a``, the velocity of the group of agent ``i`` (T3): half its own, half the mean of
-    its neighbours' weighted by their contacts."""
-    return 0.5 * (known[i, a, 1] + work[i, NEIGHBOUR_VELOCITY + a] * per_contact)
-
-
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _thermostat(i, known, setpoint, work, kept, rate, target2, inv_g, c_max, n_axes):
-    """Add agent ``i``'s thermostat push: Berendsen's on its own velocity while free (T1), on the
-    common motion of itself and its neighbours while in contact (T3), blended by its contacts (their
-    pushes' squared sizes over ``c_max^2``, up to 1).  The pushes summed before are saturated at
-    ``c_max`` first, and the thermostat's push on its own: a pair's two agents, whose pushes are
-    equal and opposite, keep them so, and the tilt may reach ``2 c_max``.
-
-    The group is half the agent, half the mean of its neighbours weighted by their contacts: the two
-    agents of a pair find the same common velocity ``V_c = (V_i + V_j) / 2`` and mean square speed
-    ``T = (|V_i|^2 + |V_j|^2) / 2``, and are pushed alike, ``dV/dt = (T* - T) V_c / (2 tau q)`` with
-    ``q = max(|V_c|^2, T / 4)`` (:data:`COMMON_FLOOR`), so that ``dT/dt = (T* - T) / tau`` while
-    ``|V_c|^2 >= T / 4``."""
-    speed2 = work[i, SPEED2]
-    contact = work[i, CONTACT]
-    together = min(1.0, contact)
-    own = (1.0 - together) * rate * (target2 / speed2 - 1.0) * inv_g if speed2 > 0.0 else 0.0
-    per_contact = 1.0 / contact if contact > 0.0 else 0.0
-    group2 = 0.5 * (speed2 + work[i, NEIGHBOUR_SPEED2] * per_contact)
-    common2 = 0.0
-    for a in range(n_axes):
-        common2 += _common(i, a, known, work, per_contact) ** 2
-    floor2 = max(common2, COMMON_FLOOR * group2)
-    common = together * rate * (target2 - group2) * inv_g / floor2 if floor2 > 0.0 else 0.0
-    pushes2 = 0.0
-    push2 = 0.0
-    for a in range(n_axes):
-        pushes2 += setpoint[i, a] * setpoint[i, a]
-        push2 += (own * known[i, a, 1] + common * _common(i, a, known, work, per_contact)) ** 2
-    pushes_scale = saturation(pushes2, c_max)
-    push_scale = saturation(push2, c_max)
-    tilt2 = 0.0
-    for a in range(n_axes):
-        setpoint[i, a] = pushes_scale * setpoint[i, a] + push_scale * (
-            own * known[i, a, 1] + common * _common(i, a, known, work, per_contact))
-        tilt2 += setpoint[i, a] * setpoint[i, a]
-    kept[i, LIMIT] = max(c_max, np.sqrt(tilt2))
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
+def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, first):
     """Agent ``i``'s part of :func:`gas_pushes`."""
     n_axes = len(box)
     walls = gas.walls
@@ -237,19 +181,22 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
     if bounded:
         contacts, pressing, work[i, WALL_PUSH], work[i, WALL_MOMENT], obstacles_virial = wall_pushes(
             i, corrected, pushed, walls, obstacles, box, wall_params, n_axes)  # fmt: skip
-    crowd = work[i, CONTACT] + pressing
-    kept[i, WEIGHT] = 1.0 / max(1.0, crowd)
-    if not first:  # the neighbours present at the start are not encounters
-        gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
-    kept[i, NEAR_BEFORE] = work[i, NEAR]
-    if gas.rate > 0.0 and gas.target2[0] > 0.0:
-        _thermostat(i, known, setpoint, work, kept, gas.rate, gas.target2[0], gas.inv_g, gas.c_max, n_axes)
-    if not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
+    thermostat = gas.rate > 0.0 and gas.target2[0] > 0.0
+    if counting:
+        kept[i, WEIGHT] = 1.0 / max(1.0, work[i, CONTACT] + pressing)
+        if not first:  # the neighbours present at the start are not encounters
+            gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
+        kept[i, NEAR_BEFORE] = work[i, NEAR]
+        if thermostat:
+            hold_group_push(i, known, work, kept, gas.rate, gas.target2[0], gas.inv_g, n_axes)
+    if thermostat:
+        add_thermostat_push(i, known, setpoint, kept, gas.rate, gas.target2[0], gas.inv_g, gas.c_max, n_axes)
+    if counting and not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
         own = 0.0
         for a in range(n_axes):
             own += (corrected[i, a, 1] - 0.5 * walls[a]) * setpoint[i, a]
         work[i, VIRIAL] = own
-    else:  # each pair's half
+    elif counting:  # each pair's half
         work[i, VIRIAL] *= 0.5
     if contacts > 0:  # what the walls drop of the others becomes the walls' own push (W2)
         held, held_moment, dropped_virial = keep_off(i, corrected, setpoint, walls, obstacles, box, wall_params.reach,
@@ -257,14 +204,16 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, first):
         others, kept[i, LIMIT] = with_priority(i, setpoint, pushed, wall_params.c_max, n_axes)
         work[i, WALL_PUSH] += others * held
         work[i, WALL_MOMENT] += others * held_moment
-        work[i, VIRIAL] = others * (work[i, VIRIAL] + dropped_virial) + obstacles_virial
+        if counting:
+            work[i, VIRIAL] = others * (work[i, VIRIAL] + dropped_virial) + obstacles_virial
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def gas_pushes(known, agents, gas, wall_params, run, n_blocks):
-    """The thermostat (T1)-(T2), then walls and obstacles (W1)-(W2), agent by agent
-    (:func:`_gas_agent`), after the neighbour pushes and the formation pairs; count the neighbours
-    that came within reach.
+def gas_pushes(known, agents, gas, wall_params, run, n_blocks, counting):
+    """Walls and obstacles (W1), the thermostat (T1), (T3), then the walls' last word (W2), agent by
+    agent (:func:`_gas_agent`), after the neighbour pushes and the formation pairs; at a count, the
+    weights of the mean of pushes (C1), the thermostat's group pushes, and the neighbours that came
+    within reach.
 
     Parameters
     ----------
@@ -276,18 +225,22 @@ def gas_pushes(known, agents, gas, wall_params, run, n_blocks):
         The repulsion's parameters with ``R + R_w`` for its reach.
     n_blocks : int
         Blocks of agents the parallel loop shares out (those of :func:`tmem.engine.stages.corrected_positions`).
+    counting : bool
+        Whether the step is a count.
     """
     box = run.box
     first = gas.first[0]
-    gas.first[0] = False
+    if counting:
+        gas.first[0] = False
     n_agents = known.shape[0]
     per_block = (n_agents + n_blocks - 1) // n_blocks
     for b in numba.prange(n_blocks):
-        _gas_block(b * per_block, min(n_agents, (b + 1) * per_block), known, agents, gas, wall_params, box, first)
+        _gas_block(b * per_block, min(n_agents, (b + 1) * per_block), known, agents, gas, wall_params, box, counting,
+                   first)  # fmt: skip
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _gas_block(begin, end, known, agents, gas, wall_params, box, first):
+def _gas_block(begin, end, known, agents, gas, wall_params, box, counting, first):
     """Agents ``begin:end`` of :func:`gas_pushes`, one after the other.
 
     Called, not inlined, once per block of agents: compiled once, the gas's code stays out of the
@@ -297,7 +250,7 @@ def _gas_block(begin, end, known, agents, gas, wall_params, box, first):
     cost more than the agent's work (its records passed each time); a call per block costs nothing."""
     for i in range(begin, end):
         if agents.active[i]:
-            _gas_agent(i, known, agents.corrected, agents.setpoint, gas, wall_params, box, first)
+            _gas_agent(i, known, agents.corrected, agents.setpoint, gas, wall_params, box, counting, first)
 
 
 @numba.njit(cache=True, inline="always")
@@ -319,9 +272,10 @@ def tilt_limit(observe, kept, i, c_max):
 
 
 @numba.njit(cache=True, inline="always")
-def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes):
-    """Add agent ``i``'s step to its totals, after its vehicle's step.  Called in a parallel loop: it
-    takes the record's arrays and numbers, not the record.
+def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sampled):
+    """Add agent ``i``'s step to its totals, after its vehicle's step: the walls' momentum and the
+    breaches at every step; at a count, the virial and the path, each as ``sampled`` steps of it.
+    Called in a parallel loop: it takes the record's arrays and numbers, not the record.
 
     Parameters
     ----------
@@ -339,12 +293,15 @@ def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes):
         ``g dt`` and ``dt``.
     n_axes : int
         Number of axes.
+    sampled : int
+        The steps a count stands for (``Gas.every``); 0 at a step that is not a count.
     """
     applied = scale * g_dt
     totals[i, WALL_MOMENTUM] += applied * work[i, WALL_PUSH]
     totals[i, WALL_VIRIAL] += applied * work[i, WALL_MOMENT]
-    totals[i, VIRIAL_TOTAL] += applied * work[i, VIRIAL]
-    totals[i, PATH] += np.sqrt(work[i, SPEED2]) * dt
+    if sampled > 0:
+        totals[i, VIRIAL_TOTAL] += sampled * applied * work[i, VIRIAL]
+        totals[i, PATH] += sampled * np.sqrt(work[i, SPEED2]) * dt
     outside = False
     for a in range(n_axes):
         if walls[a] > 0.0 and not 0.0 <= x[i, a, 0] <= walls[a]:
@@ -409,7 +366,7 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
     rms = thermostat.rms_velocity if thermostat is not None else None
     tau = thermostat.tau if thermostat is not None else ThermostatParams().tau
     dt = scenario.simulation.dt
-    kept = np.zeros((size, 3))
+    kept = np.zeros((size, COMMON + space.axes))
     kept[:, WEIGHT] = 1.0  # no contacts yet
     return Gas(
         observe=observe,
@@ -419,6 +376,7 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         inv_g=1.0 / acceleration_per_tilt,
         g_dt=acceleration_per_tilt * dt,
         dt=dt,
+        every=max(1, round(scenario.simulation.gas_period / dt)),
         walls=walls,
         obstacles=obstacles,
         wall_reach=scenario.wall_reach,

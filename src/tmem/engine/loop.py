@@ -67,7 +67,8 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     Each step: commands -> measurement -> P* (6) -> neighbour pushes -> formation pairs -> thermostat,
     walls and obstacles (when the gas is observed) -> record -> saturate the set-point and step the
     vehicles (held over ``dt``).  On the sensed path each agent measures, and pushes from what it
-    measured."""
+    measured.  When the gas is observed, its counts are taken at the steps that are multiples of
+    ``gas.every``."""
     listed = 1 if SENSED else 0  # the lists hold P* (6); with sensing, P (the range is one of positions)
     box = run.box
     n_axes = len(box)
@@ -78,14 +79,15 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     active = agents.active
     observe = OBSERVED
     work, kept, totals = gas.work, gas.kept, gas.totals  # parallel loops take arrays, not records
-    walls, obstacles, g_dt, dt = gas.walls, gas.obstacles, gas.g_dt, gas.dt
+    walls, obstacles, g_dt, dt, every = gas.walls, gas.obstacles, gas.g_dt, gas.dt, gas.every
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
+        counting = OBSERVED and k % every == 0
         rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters, gas)
         known = x
         if SENSED:
             known = measure(k, x, sensing)
-        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, listed, observe)
+        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, listed, observe, counting)
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
             for i in range(x.shape[0]):
                 for a in range(n_axes):
@@ -95,10 +97,10 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
             sensed_neighbour_pushes(k, agents, neighbours, law, params, run, sensing)
             sensed_formation_pairs(k, agents, pairs, law, params, run, events, counters, sensing)
         else:
-            neighbour_pushes(agents, neighbours, law, params, run, gas)
-            formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas)
+            neighbour_pushes(agents, neighbours, law, params, run, gas, counting)
+            formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas, counting)
         if OBSERVED:
-            gas_pushes(known, agents, gas, wall_params, run, neighbours.block_shift2.shape[0])
+            gas_pushes(known, agents, gas, wall_params, run, neighbours.block_shift2.shape[0], counting)
         if is_recorded(k, run):
             record(agents, pairs, records, c_max, run, counters, gas, SENSED)
         if k < run.n_steps:
@@ -110,7 +112,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
                             x[i, a, 0] = into_box(x[i, a, 0], box[a])
                     if observe:
-                        tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes)
+                        tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, every if counting else 0)
     counters.step[0] = k_stop
     return DONE
 

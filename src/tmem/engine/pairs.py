@@ -242,10 +242,11 @@ def check_flag(k, e, r, d, known, i, j, pairs, law, params, n_axes, events, coun
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _count_pair(e, agents, pairs, law, params, box, gas):
-    """For the gas (:mod:`tmem.engine.gas`): pair ``e``, if within reach, counted as the neighbour
-    stage counts its pairs; with no coupling flag (the tracked pairs of a small swarm) it is a plain
-    neighbour, and the mean of pushes (C1) divides its push too.  ``pairs.d`` holds its push on ``i``."""
+def _count_pair(e, agents, pairs, law, params, box, gas, counting):
+    """For the gas (:mod:`tmem.engine.gas`): pair ``e``, if within reach, with no coupling flag (the
+    tracked pairs of a small swarm) is a plain neighbour, and the mean of pushes (C1) divides its push
+    too; at a count, it is counted as the neighbour stage counts its pairs.  ``pairs.d`` holds its
+    push on ``i``."""
     i = pairs.i[e]
     j = pairs.j[e]
     if not (agents.active[i] and agents.active[j]) or not pairs.r_before[e] < params.reach:
@@ -263,6 +264,8 @@ def _count_pair(e, agents, pairs, law, params, box, gas):
                 agents.setpoint[i, a] -= (1.0 - share) * d[a]
                 agents.setpoint[j, a] += (1.0 - share) * d[a]
                 d[a] *= share
+    if not counting:
+        return
     virial = 0.0
     for a in range(n_axes):
         virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
@@ -270,9 +273,9 @@ def _count_pair(e, agents, pairs, law, params, box, gas):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas):
-    """Every formation pair's step, :func:`formation_pair`, in order; counted for the gas when it is
-    observed (:func:`_count_pair`).
+def formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas, counting):
+    """Every formation pair's step, :func:`formation_pair`, in order; weighted and counted for the gas
+    when it is observed (:func:`_count_pair`).
 
     Parameters
     ----------
@@ -285,8 +288,10 @@ def formation_pairs(k, known, agents, pairs, law, params, run, events, counters,
         ``counters`` and ``gas`` change in place.
     params : FunctionParams
         The interaction functions' parameters.
+    counting : bool
+        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).
     """
     for e in range(pairs.i.shape[0]):
         formation_pair(k, e, known, agents, pairs, law, params, run.box, events, counters)
         if gas.observe:
-            _count_pair(e, agents, pairs, law, params, run.box, gas)
+            _count_pair(e, agents, pairs, law, params, run.box, gas, counting)

@@ -4,8 +4,8 @@ Step 4 of the loop (:mod:`tmem.engine.stages` lists them all).  Each pair ``(i, 
 neighbour lists (:mod:`tmem.neighbors`) is pushed once, equal and opposite, with the interaction
 function of :attr:`tmem.engine.records.Law.neighbour_function` along ``d / |d|``, ``d = P*_j - P*_i``
 (6).  Pairs are gathered into chunks, pushed in vectorised arithmetic (:func:`_chunk_pushes`), then
-added to the set-points.  When the gas is observed, the adding also counts each pair for the gas
-(:func:`_add_counted`; :mod:`tmem.engine.gas`).
+added to the set-points, weighted under the mean of pushes (C1).  At a count of the gas, the adding
+also counts each pair for the gas (:func:`_add_counted`; :mod:`tmem.engine.gas`).
 """
 
 from __future__ import annotations
@@ -44,11 +44,11 @@ def _chunk_pushes(chunks, w, m, n_axes, function, params):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, chunks, w, gas):
+def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, chunks, w, gas, counting):
     """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
     the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
-    the work space.  When the gas is observed, count each agent's neighbours within reach, the sum of
-    their ``|V|^2`` and the virial of the pushes (:class:`tmem.engine.records.Gas`).
+    the work space.  Under the mean of pushes (C1) each push is weighted; at a count of the gas, each
+    pair is counted for both its agents too (:func:`_add_counted`).
 
     Called, not inlined: the loop calls it from two places, and each inlined copy of it (with the
     interaction functions inside) cost two seconds of the first run's compilation.  The call costs
@@ -66,16 +66,24 @@ def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, c
         _chunk_pushes(chunks, w, m, n_axes, function, params)
         for t in range(m):
             nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
-        if gas.observe:
+        if counting:
             _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known)
-            continue
-        for t in range(m):
-            i = pairs[begin + t, 0]
-            j = pairs[begin + t, 1]
-            for a in range(n_axes):
-                u[i, a] += chunks[w, a, t]
-                u[j, a] -= chunks[w, a, t]
+        else:
+            _add_pushes(chunks, w, m, pairs, begin, n_axes, u, gas.kept, gas.mean)
     return nearest2
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _add_pushes(chunks, w, m, pairs, begin, n_axes, u, kept, weighted):
+    """Add a chunk's pushes to ``u``, equal and opposite; when ``weighted``, each divided by
+    :func:`tmem.engine.gas.pair_share`, the weight its agents broadcast at the last count (C1)."""
+    for t in range(m):
+        i = pairs[begin + t, 0]
+        j = pairs[begin + t, 1]
+        share = pair_share(i, j, kept) if weighted else 1.0
+        for a in range(n_axes):
+            u[i, a] += chunks[w, a, t] * share
+            u[j, a] -= chunks[w, a, t] * share
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -110,7 +118,7 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def neighbour_pushes(agents, neighbours, law, params, run, gas):
+def neighbour_pushes(agents, neighbours, law, params, run, gas, counting):
     """Sum the pushes of every listed non-formation pair within reach, ``f(|d|)`` along ``d / |d|``.
 
     (Parallel loops take plain arrays and numbers: the records' fields are read out before them.)
@@ -125,6 +133,8 @@ def neighbour_pushes(agents, neighbours, law, params, run, gas):
         in place.
     params : tmem.interaction.kernels.FunctionParams
         The interaction functions' parameters.
+    counting : bool
+        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).
     """
     box = run.box
     function = law.neighbour_function
@@ -140,11 +150,11 @@ def neighbour_pushes(agents, neighbours, law, params, run, gas):
         block_nearest2[b] = np.inf
         if block_ptr[b + 1] > block_ptr[b]:
             block_nearest2[b] = _pushes_of(corrected, known, pairs, block_ptr[b], block_ptr[b + 1], box, function,
-                                           params, setpoint, chunks, b, gas)  # fmt: skip
+                                           params, setpoint, chunks, b, gas, counting)  # fmt: skip
     nearest2 = np.inf
     if neighbours.n_pairs > neighbours.n_inside:
         nearest2 = _pushes_of(corrected, known, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params,
-                              setpoint, chunks, n_blocks, gas)  # fmt: skip
+                              setpoint, chunks, n_blocks, gas, counting)  # fmt: skip
     for b in range(n_blocks):
         nearest2 = min(nearest2, block_nearest2[b])
     neighbours.closest[0] = min(neighbours.closest[0], nearest2)

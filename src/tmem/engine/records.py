@@ -256,6 +256,9 @@ class Gas(NamedTuple):
         ``g dt``: a tilt (rad) held over a step as a change of velocity (m/s).
     dt : float
         The step (s).
+    every : int
+        Steps from one count to the next (``simulation.gas_period / dt``, at least 1): the pairs'
+        counts and what they set are taken at the steps that are multiples of it.
     walls : ndarray, shape (axes,)
         Sides of the walled box, from 0 to ``walls[a]`` on axis ``a`` (0: no walls on that axis).
     obstacles : ndarray, shape (obstacles, axes + 1)
@@ -267,12 +270,13 @@ class Gas(NamedTuple):
     first : ndarray, shape (1,), bool
         True until the first step's neighbours are counted: they are not encounters.
     work : ndarray, shape (agents, 7 + axes) (no rows when not observed)
-        Each agent's work space of a step, in the columns :data:`tmem.engine.gas.NEAR` ...
-        :data:`tmem.engine.gas.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's counts touch
-        two rows.
-    kept : ndarray, shape (agents, 3)
-        What each agent keeps from step to step (:data:`tmem.engine.gas.NEAR_BEFORE` ...
-        :data:`tmem.engine.gas.LIMIT`), among them the weight of its pushes, which it broadcasts (C1).
+        Each agent's work space of a count, in the columns :data:`tmem.engine.gas_columns.NEAR` ...
+        :data:`tmem.engine.gas_columns.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's
+        counts touch two rows.
+    kept : ndarray, shape (agents, 4 + axes)
+        What each agent keeps from step to step (:data:`tmem.engine.gas_columns.NEAR_BEFORE` ...
+        :data:`tmem.engine.gas_columns.COMMON`), among them the weight of its pushes, which it
+        broadcasts (C1), and its thermostat's group push (T3).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)
@@ -286,6 +290,7 @@ class Gas(NamedTuple):
     inv_g: float
     g_dt: float
     dt: float
+    every: int
     walls: np.ndarray
     obstacles: np.ndarray
     wall_reach: float

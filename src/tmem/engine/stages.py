@@ -12,8 +12,8 @@ work space comes in the records.
    lists have drifted;
 4. :func:`tmem.engine.pushes.neighbour_pushes` — the pushes of the non-formation neighbours;
 5. :func:`tmem.engine.pairs.formation_pairs` — each pair's flag ``F_en`` and its pull or push;
-   then, when the gas is observed, :func:`tmem.engine.gas.gas_pushes` — thermostat, walls and
-   obstacles;
+   then, when the gas is observed, :func:`tmem.engine.gas.gas_pushes` — walls, obstacles and the
+   thermostat (the gas's counts are taken every ``Gas.every`` steps, in steps 3 to 5);
 6. :func:`record` — the recorded step;
 7. combining and saturating the set-point (:func:`tmem.control.tilt_scale`) and the
    vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
@@ -152,10 +152,10 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def corrected_positions(known, agents, law, run, neighbours, gas, listed, observe):
+def corrected_positions(known, agents, law, run, neighbours, gas, listed, observe, counting):
     """``P* = x . K / K_P`` (6) of every agent as it knows itself, and its true ``P``, into
-    ``agents.corrected``; clear the set-points (and, when the gas is observed, its counts:
-    :func:`tmem.engine.gas.clear`).
+    ``agents.corrected``; clear the set-points (and, when the gas is observed, its tilt limits and, at
+    a count, its counts: :func:`tmem.engine.gas.clear`).
 
     Returns the largest squared shift of a flying agent's listed point (``P*``, or ``P`` with sensing)
     since the lists were built (0 without lists).
@@ -172,6 +172,8 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
         is one of positions).
     observe : bool
         ``Gas.observe``, a constant of the compiled loop (:data:`tmem.engine.loop.OBSERVED`).
+    counting : bool
+        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).
     """
     box = run.box
     work = gas.work
@@ -206,7 +208,7 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
                     delta = nearest_image((star if listed == 0 else position) - p_ref[i, a], box[a])
                     shift2 += delta * delta
             if observe:
-                clear(i, known, work, kept, c_max, n_axes)
+                clear(i, known, work, kept, c_max, n_axes, counting)
             if active[i]:
                 largest = max(largest, shift2)
         block_shift2[b] = largest

@@ -57,7 +57,7 @@ class CoverageParams(StrictModel):
 class ThermostatParams(StrictModel):
     """The swarm's temperature as an operator's set-point: its RMS velocity ``rms_velocity`` (m/s;
     none: the thermostat waits for a ``temperature`` command), reached with time constant ``tau`` (s)
-    (:mod:`tmem.engine.gas`)."""
+    (:mod:`tmem.engine.thermostat`)."""
 
     rms_velocity: Positive | None = None
-    tau: Annotated[float, Field(gt=0, le=LIMIT)] = 5.0
+    tau: Annotated[float, Field(gt=0, le=LIMIT)] = 1.0

@@ -215,13 +215,18 @@ class InteractionParams(StrictModel):
 
 
 class SimulationParams(StrictModel):
-    """Time stepping and recording (``record_agents``: the agents recorded; all by default)."""
+    """Time stepping and recording (``record_agents``: the agents recorded; all by default).
+
+    ``gas_period`` (s): how often the gas's counts are taken (:mod:`tmem.engine.gas`), rounded to
+    whole steps, at least one.  At most 1 s: what the counts set, the weights of the mean of pushes
+    and the thermostat's group pushes, is held that long."""
 
     dt: Annotated[float, Field(ge=1e-9, le=LIMIT)] = 1e-4
     duration: Positive = 60.0
     record_every: Annotated[int, Field(ge=1)] = 100
     record_agents: list[int] | None = None
     observe_gas: bool = False
+    gas_period: Annotated[float, Field(gt=0, le=1.0)] = 0.1
 
     @property
     def n_steps(self) -> int:
