@@ -3,14 +3,16 @@
 The plain case is benchmarks/bench_gas.py's gas-N (2-D periodic box, six neighbours within
 R + R_j on average, repulsion, dt = 0.01 s, 1000 steps, nothing recorded).  The cases with options
 put the same agents in a walled box of the same side and hold them at their 3 m/s with the
-thermostat, which turns on every gas stage: the neighbour counts, walls, thermostat and running
-totals; the last also averages their pushes (``interaction.combine = "mean"``).  The cases
-alternate, after one compile run each; each figure is the median of ``--repeat`` runs, in
+thermostat, which turns on every gas stage: the neighbour counts (every ``simulation.gas_period``,
+0.1 s: every 10th step), walls, thermostat and running totals; the last also averages their pushes
+(``interaction.combine = "mean"``).  ``--each`` adds each option on its own: the gas observed and
+nothing else, the periodic box with the mean of pushes, with the thermostat, and the walled box.
+The cases alternate, after one compile run each; each figure is the median of ``--repeat`` runs, in
 agent-steps per second, and each ratio is that of the medians.
 
 Usage::
 
-    python benchmarks/bench_gas_options.py --n 100000 --repeat 5 [--json benchmarks/results/gas_options.json]
+    python benchmarks/bench_gas_options.py --n 100000 --repeat 5 [--each] [--json benchmarks/results/gas_options.json]
 """
 
 from __future__ import annotations
@@ -35,16 +37,27 @@ def with_options(n: int, *, mean: bool, steps: int = STEPS):
                                 "interaction.combine": "mean" if mean else "sum"})  # fmt: skip
 
 
+def each_option(n: int) -> dict:
+    """gas-N with one option at a time."""
+    plain = gas(n)
+    walled = {"space.periodic": False, "space.walls": True}
+    return {"observe_gas": with_changes(plain, {"simulation.observe_gas": True}),
+            "periodic, mean of pushes": with_changes(plain, {"interaction.combine": "mean"}),
+            "periodic, thermostat": with_changes(plain, {"thermostat": {"rms_velocity": 3.0}}),
+            "walls": with_changes(plain, walled)}  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, nargs="+", default=[100_000])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--each", action="store_true", help="also each option on its own")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     rows = []
     for n in args.n:
         cases = {"plain": gas(n), "walls + thermostat": with_options(n, mean=False),
-                 "walls + thermostat + mean": with_options(n, mean=True)}  # fmt: skip
+                 "walls + thermostat + mean": with_options(n, mean=True), **(each_option(n) if args.each else {})}  # fmt: skip
         for scenario in cases.values():  # compile, or load from the cache
             tmem.simulate(with_changes(scenario, {"simulation.duration": 5 * DT, "simulation.record_every": 5}), record=False)
         seconds = {name: [] for name in cases}

@@ -130,7 +130,7 @@ CASES = {
     "fig9": (fig9, 10.0, 20.0, lambda saved, run: saved.arrays["pairs.flag"][0] == 1),  # coupled
     "neighbour lists": (neighbour_lists, 1.0, 2.0, lambda saved, run: 1 < saved.list_builds < run.list_builds),
     "gas box": (gas_box, 1.0, 3.0, lambda saved, run: saved.arrays["gas.target2"][0] == 9.0  # the command's, not 4
-                and np.any(saved.arrays["gas.kept"][:, COMMON:] != 0.0)),  # group pushes held
+                and np.any(saved.arrays["gas.held"][:, COMMON:] != 0.0)),  # group pushes held
     "hex19": (hex19, 2.0, 4.0, lambda saved, run: saved.arrays["agents.active"].sum() == 18),  # agent 3 lost
     "quadrotor hex19": (quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.any(saved.arrays["agents.body"] != saved.arrays["agents.body_start"])),
     "turbulent quadrotor hex19": (turbulent_quadrotor_hex19, 1.0, 2.0, lambda saved, run: np.all(saved.arrays["agents.body"][:, BODY_NAMES.index("gust_step")] > 0)),

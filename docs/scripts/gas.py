@@ -75,19 +75,22 @@ def roots() -> None:
 
 
 def drift() -> None:
-    """RMS velocity of the gas at 1, 6 and 12 neighbours, summed and averaged pushes, dt = 1 ms."""
+    """RMS velocity of the gas at 1, 6 and 12 neighbours, summed and averaged pushes, and averaged
+    with the thermostat holding 3 m/s; dt = 1 ms."""
     times = (0, 10, 20, 40, 60, 90, 120)
     print("\n| neighbours | pushes | " + " | ".join(f"t = {t} s" for t in times) + " | drift 10-120 s |")
     print("| --- | --- |" + " --- |" * (len(times) + 1))
     for n in NEIGHBOURS:
-        for combine in ("sum", "mean"):
+        for combine, held in (("sum", False), ("mean", False), ("mean", True)):
             data = _gas(n, interaction__combine=combine, simulation__dt=0.001, simulation__duration=120.0,
                         simulation__record_every=1000, simulation__observe_gas=True)  # fmt: skip
+            if held:  # the thermostat at its default tau, holding 3 m/s
+                data["thermostat"] = {"rms_velocity": 3.0}
             tr = tmem.simulate(from_dict(data))
             rms = temperature(tr)
             at = {t: rms[np.searchsorted(tr.time, t)] for t in times}
-            print(f"| {n:g} | {combine} | " + " | ".join(f"{at[t]:.3f}" for t in times)
-                  + f" | {100 * (at[120] / at[10] - 1):+.1f} % |", flush=True)  # fmt: skip
+            print(f"| {n:g} | {combine}{', thermostat at 3 m/s' if held else ''} | " + " | ".join(f"{at[t]:.3f}" for t in times)
+                  + f" | {100 * (at[120] / at[10] - 1):+.2f} % |", flush=True)  # fmt: skip
 
 
 def encounter_gain() -> None:

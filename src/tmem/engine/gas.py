@@ -32,8 +32,7 @@ import numpy as np
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from ..scenario import ThermostatParams
 from ..space import nearest_image
-from .gas_columns import (CONTACT, NEAR, NEAR_BEFORE, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL, WALL_MOMENT,
-                          WALL_PUSH, COMMON, LIMIT, WEIGHT)  # fmt: skip
+from .gas_columns import COMMON, CONTACT, NEAR, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL
 from .records import Gas
 from .thermostat import add_thermostat_push, hold_group_push
 from .walls import keep_off, wall_pushes, with_priority
@@ -65,9 +64,8 @@ SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
 
 
 @numba.njit(cache=True, inline="always")
-def clear(i, known, work, kept, c_max, n_axes, counting):
-    """Start agent ``i``'s step: its tilt limit ``c_max``; at a count, nothing counted yet and its own
-    ``|V|^2`` as known.
+def clear(i, known, work, n_axes, counting):
+    """Start agent ``i``'s count: nothing counted yet, and its own ``|V|^2`` as known.
 
     Called in a parallel loop: it takes the record's arrays, not the record.
 
@@ -77,16 +75,13 @@ def clear(i, known, work, kept, c_max, n_axes, counting):
         The agent's slot.
     known : ndarray, shape (agents, axes, n_state)
         The states as measured.
-    work, kept : ndarray
-        ``Gas.work`` and ``Gas.kept`` (:class:`tmem.engine.records.Gas`), changed in place.
-    c_max : float
-        The scenario's tilt limit (rad).
+    work : ndarray
+        ``Gas.work`` (:class:`tmem.engine.records.Gas`), changed in place.
     n_axes : int
         Number of axes.
     counting : bool
-        Whether the step is a count.
+        Whether the step is a count: at other steps nothing is done.
     """
-    kept[i, LIMIT] = c_max
     if not counting:
         return
     speed2 = 0.0
@@ -98,7 +93,7 @@ def clear(i, known, work, kept, c_max, n_axes, counting):
 
 
 @numba.njit(cache=True, inline="always")
-def pair_share(i, j, kept):
+def pair_share(i, j, weight):
     """The weight (C1) of the push of the pair ``(i, j)``: one over the larger of its agents' contacts
     (at least one), the smaller of their weights.  Each agent inverts its contacts once a step, so
     that no pair divides.
@@ -107,10 +102,10 @@ def pair_share(i, j, kept):
     ----------
     i, j : int
         The agents' slots.
-    kept : ndarray
-        ``Gas.kept``.
+    weight : ndarray, shape (agents,)
+        ``Gas.weight``.
     """
-    return min(kept[i, WEIGHT], kept[j, WEIGHT])
+    return min(weight[i], weight[j])
 
 
 @numba.njit(cache=True, inline="always")
@@ -170,27 +165,31 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, f
     walls = gas.walls
     obstacles = gas.obstacles
     work = gas.work
-    kept = gas.kept
+    limit = gas.limit
     pushed = gas.pushed
     bounded = obstacles.shape[0] > 0
     for a in range(n_axes):
         bounded = bounded or walls[a] > 0.0
     contacts = 0
     pressing = 0.0
+    on_walls = 0.0
+    moment = 0.0
     obstacles_virial = 0.0
     if bounded:
-        contacts, pressing, work[i, WALL_PUSH], work[i, WALL_MOMENT], obstacles_virial = wall_pushes(
-            i, corrected, pushed, walls, obstacles, box, wall_params, n_axes)  # fmt: skip
+        contacts, pressing, on_walls, moment, obstacles_virial = wall_pushes(i, corrected, pushed, walls, obstacles, box,
+                                                                             wall_params, n_axes)  # fmt: skip
     thermostat = gas.rate > 0.0 and gas.target2[0] > 0.0
     if counting:
-        kept[i, WEIGHT] = 1.0 / max(1.0, work[i, CONTACT] + pressing)
+        gas.weight[i] = 1.0 / max(1.0, work[i, CONTACT] + pressing)
         if not first:  # the neighbours present at the start are not encounters
-            gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - kept[i, NEAR_BEFORE], 0.0)
-        kept[i, NEAR_BEFORE] = work[i, NEAR]
+            gas.totals[i, ENCOUNTERS] += max(work[i, NEAR] - gas.near_before[i], 0.0)
+        gas.near_before[i] = work[i, NEAR]
         if thermostat:
-            hold_group_push(i, known, work, kept, gas.rate, gas.target2[0], gas.inv_g, n_axes)
+            hold_group_push(i, known, work, gas.held, gas.rate, gas.target2[0], gas.inv_g, n_axes)
     if thermostat:
-        add_thermostat_push(i, known, setpoint, kept, gas.rate, gas.target2[0], gas.inv_g, gas.c_max, n_axes)
+        add_thermostat_push(i, known, setpoint, gas.held, limit, gas.rate, gas.target2[0], gas.inv_g, gas.c_max, n_axes)
+    else:
+        limit[i] = gas.c_max
     if counting and not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
         own = 0.0
         for a in range(n_axes):
@@ -201,9 +200,10 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, f
     if contacts > 0:  # what the walls drop of the others becomes the walls' own push (W2)
         held, held_moment, dropped_virial = keep_off(i, corrected, setpoint, walls, obstacles, box, wall_params.reach,
                                                       n_axes)  # fmt: skip
-        others, kept[i, LIMIT] = with_priority(i, setpoint, pushed, wall_params.c_max, n_axes)
-        work[i, WALL_PUSH] += others * held
-        work[i, WALL_MOMENT] += others * held_moment
+        others, limit[i] = with_priority(i, setpoint, pushed, wall_params.c_max, n_axes)
+        # the set-point is now within its limit and is applied as it stands: the walls take this
+        gas.totals[i, WALL_MOMENTUM] += gas.g_dt * (on_walls + others * held)
+        gas.totals[i, WALL_VIRIAL] += gas.g_dt * (moment + others * held_moment)
         if counting:
             work[i, VIRIAL] = others * (work[i, VIRIAL] + dropped_virial) + obstacles_virial
 
@@ -254,28 +254,29 @@ def _gas_block(begin, end, known, agents, gas, wall_params, box, counting, first
 
 
 @numba.njit(cache=True, inline="always")
-def tilt_limit(observe, kept, i, c_max):
+def tilt_limit(observe, limit, i, c_max):
     """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`tmem.engine.walls.with_priority`).
 
     Parameters
     ----------
     observe : bool
-        Whether the gas is observed (``Gas.observe``; else ``kept`` is empty).
-    kept : ndarray
-        ``Gas.kept``.
+        Whether the gas is observed (``Gas.observe``; else ``limit`` is empty).
+    limit : ndarray, shape (agents,)
+        ``Gas.limit``.
     i : int
         The agent's slot.
     c_max : float
         The scenario's tilt limit (rad).
     """
-    return kept[i, LIMIT] if observe else c_max
+    return limit[i] if observe else c_max
 
 
 @numba.njit(cache=True, inline="always")
 def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sampled):
-    """Add agent ``i``'s step to its totals, after its vehicle's step: the walls' momentum and the
-    breaches at every step; at a count, the virial and the path, each as ``sampled`` steps of it.
-    Called in a parallel loop: it takes the record's arrays and numbers, not the record.
+    """Add agent ``i``'s step to its totals, after its vehicle's step: the breaches at every step; at
+    a count, the virial and the path, each as ``sampled`` steps of it (the walls' momentum is added
+    where the walls push, :func:`gas_pushes`).  Called in a parallel loop: it takes the record's
+    arrays and numbers, not the record.
 
     Parameters
     ----------
@@ -296,11 +297,8 @@ def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sa
     sampled : int
         The steps a count stands for (``Gas.every``); 0 at a step that is not a count.
     """
-    applied = scale * g_dt
-    totals[i, WALL_MOMENTUM] += applied * work[i, WALL_PUSH]
-    totals[i, WALL_VIRIAL] += applied * work[i, WALL_MOMENT]
     if sampled > 0:
-        totals[i, VIRIAL_TOTAL] += sampled * applied * work[i, VIRIAL]
+        totals[i, VIRIAL_TOTAL] += sampled * scale * g_dt * work[i, VIRIAL]
         totals[i, PATH] += sampled * np.sqrt(work[i, SPEED2]) * dt
     outside = False
     for a in range(n_axes):
@@ -366,8 +364,6 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
     rms = thermostat.rms_velocity if thermostat is not None else None
     tau = thermostat.tau if thermostat is not None else ThermostatParams().tau
     dt = scenario.simulation.dt
-    kept = np.zeros((size, COMMON + space.axes))
-    kept[:, WEIGHT] = 1.0  # no contacts yet
     return Gas(
         observe=observe,
         mean=scenario.interaction.combine == "mean",
@@ -383,7 +379,10 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         c_max=scenario.interaction.c_max,
         first=np.ones(1, dtype=np.bool_),
         work=np.zeros((size, NEIGHBOUR_VELOCITY + space.axes)),
-        kept=kept,
+        weight=np.ones(size),  # no contacts yet
+        near_before=np.zeros(size),
+        limit=np.zeros(size),
+        held=np.zeros((size, COMMON + space.axes)),
         pushed=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),
     )

@@ -1,4 +1,4 @@
-"""The columns of the gas's per-agent arrays, ``Gas.work`` and ``Gas.kept``
+"""The columns of the gas's per-agent tables, ``Gas.work`` and ``Gas.held``
 (:class:`tmem.engine.records.Gas`), shared by the gas's stages (:mod:`tmem.engine.gas`) and the
 thermostat (:mod:`tmem.engine.thermostat`).
 
@@ -8,13 +8,11 @@ hold between counts is kept.
 """
 
 #: Columns of ``Gas.work``, cleared at each count: neighbours within reach, their pushes' squared
-#: sizes over ``c_max^2`` (the agent's contacts), the agent's virial (rad m), its ``|V|^2``, the size
-#: of the box walls' pushes (rad) and their moment about the walls (rad m) (both written at every
-#: step), its neighbours' ``|V|^2`` and, from :data:`NEIGHBOUR_VELOCITY` on, one column per axis,
-#: their velocities, each neighbour weighted by its contact (T3).
-NEAR, CONTACT, VIRIAL, SPEED2, WALL_PUSH, WALL_MOMENT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY = range(8)
-#: Columns of ``Gas.kept``, kept from step to step: neighbours within reach at the count before,
-#: the weight of its pushes, ``1 / max(1, contacts)`` (C1), its tilt limit this step, how far it is
-#: in contact (T3: :data:`tmem.engine.thermostat.FULL_CONTACT`), and from :data:`COMMON` on, one
-#: column per axis, the thermostat's push on its group (rad, T3), each from the last count.
-NEAR_BEFORE, WEIGHT, LIMIT, TOGETHER, COMMON = range(5)
+#: sizes over ``c_max^2`` (the agent's contacts), the agent's virial (rad m), its ``|V|^2``, its
+#: neighbours' ``|V|^2`` and, from :data:`NEIGHBOUR_VELOCITY` on, one column per axis, their
+#: velocities, each neighbour weighted by its contact (T3).
+NEAR, CONTACT, VIRIAL, SPEED2, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY = range(6)
+#: Columns of ``Gas.held``, what the thermostat holds from one count to the next (T3): how far the
+#: agent is in contact (:data:`tmem.engine.thermostat.FULL_CONTACT`), and from :data:`COMMON` on, one
+#: column per axis, its push on the agent's group (rad).  The thermostat reads them at every step.
+TOGETHER, COMMON = range(2)

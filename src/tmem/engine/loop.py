@@ -78,7 +78,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     body = agents.body
     active = agents.active
     observe = OBSERVED
-    work, kept, totals = gas.work, gas.kept, gas.totals  # parallel loops take arrays, not records
+    work, limit, totals = gas.work, gas.limit, gas.totals  # parallel loops take arrays, not records
     walls, obstacles, g_dt, dt, every = gas.walls, gas.obstacles, gas.g_dt, gas.dt, gas.every
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
@@ -106,7 +106,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
         if k < run.n_steps:
             for i in numba.prange(x.shape[0]):
                 if active[i]:
-                    scale = tilt_scale(u, i, n_axes, tilt_limit(observe, kept, i, c_max))
+                    scale = tilt_scale(u, i, n_axes, tilt_limit(observe, limit, i, c_max))
                     vehicle_step(x, body, u, i, scale, vehicle, n_axes)
                     for a in range(n_axes):
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0

@@ -258,7 +258,7 @@ def _count_pair(e, agents, pairs, law, params, box, gas, counting):
         size2 += d[a] * d[a]
     pressing = size2 / (params.c_max * params.c_max)
     if gas.mean and not law.couples:
-        share = pair_share(i, j, gas.kept)
+        share = pair_share(i, j, gas.weight)
         if share < 1.0:
             for a in range(n_axes):
                 agents.setpoint[i, a] -= (1.0 - share) * d[a]

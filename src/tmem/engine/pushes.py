@@ -69,18 +69,18 @@ def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, c
         if counting:
             _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known)
         else:
-            _add_pushes(chunks, w, m, pairs, begin, n_axes, u, gas.kept, gas.mean)
+            _add_pushes(chunks, w, m, pairs, begin, n_axes, u, gas.weight, gas.mean)
     return nearest2
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _add_pushes(chunks, w, m, pairs, begin, n_axes, u, kept, weighted):
+def _add_pushes(chunks, w, m, pairs, begin, n_axes, u, weight, weighted):
     """Add a chunk's pushes to ``u``, equal and opposite; when ``weighted``, each divided by
     :func:`tmem.engine.gas.pair_share`, the weight its agents broadcast at the last count (C1)."""
     for t in range(m):
         i = pairs[begin + t, 0]
         j = pairs[begin + t, 1]
-        share = pair_share(i, j, kept) if weighted else 1.0
+        share = pair_share(i, j, weight) if weighted else 1.0
         for a in range(n_axes):
             u[i, a] += chunks[w, a, t] * share
             u[j, a] -= chunks[w, a, t] * share
@@ -95,7 +95,7 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known):
     than being skipped: whether a listed pair is within reach is a coin toss the processor cannot
     predict, and the branch cost more than the adds."""
     work = gas.work
-    kept = gas.kept
+    weight = gas.weight
     mean = gas.mean
     pair_virial = virial_by_pairs(gas.walls)
     inv_c_max2 = 1.0 / (gas.c_max * gas.c_max)
@@ -105,7 +105,7 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known):
         size2 = 0.0
         for a in range(n_axes):
             size2 += chunks[w, a, t] * chunks[w, a, t]
-        share = pair_share(i, j, kept) if mean else 1.0
+        share = pair_share(i, j, weight) if mean else 1.0
         virial = 0.0
         for a in range(n_axes):
             push = chunks[w, a, t] * share

@@ -273,10 +273,17 @@ class Gas(NamedTuple):
         Each agent's work space of a count, in the columns :data:`tmem.engine.gas_columns.NEAR` ...
         :data:`tmem.engine.gas_columns.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's
         counts touch two rows.
-    kept : ndarray, shape (agents, 4 + axes)
-        What each agent keeps from step to step (:data:`tmem.engine.gas_columns.NEAR_BEFORE` ...
-        :data:`tmem.engine.gas_columns.COMMON`), among them the weight of its pushes, which it
-        broadcasts (C1), and its thermostat's group push (T3).
+    weight : ndarray, shape (agents,)
+        The weight of each agent's pushes, ``1 / max(1, contacts)`` (C1), which it broadcasts at each
+        count.
+    near_before : ndarray, shape (agents,)
+        Each agent's neighbours within reach at the count before.
+    limit : ndarray, shape (agents,)
+        Each agent's tilt limit this step: ``c_max``, more in a corner (W2) or with the thermostat's
+        push (:mod:`tmem.engine.thermostat`).
+    held : ndarray, shape (agents, 1 + axes)
+        What the thermostat holds from one count to the next, in the columns of
+        :mod:`tmem.engine.gas_columns` (T3).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)
@@ -297,7 +304,10 @@ class Gas(NamedTuple):
     c_max: float
     first: np.ndarray
     work: np.ndarray
-    kept: np.ndarray
+    weight: np.ndarray
+    near_before: np.ndarray
+    limit: np.ndarray
+    held: np.ndarray
     pushed: np.ndarray
     totals: np.ndarray
 

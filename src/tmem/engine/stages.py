@@ -154,8 +154,8 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def corrected_positions(known, agents, law, run, neighbours, gas, listed, observe, counting):
     """``P* = x . K / K_P`` (6) of every agent as it knows itself, and its true ``P``, into
-    ``agents.corrected``; clear the set-points (and, when the gas is observed, its tilt limits and, at
-    a count, its counts: :func:`tmem.engine.gas.clear`).
+    ``agents.corrected``; clear the set-points (and, at a count of the gas, its counts:
+    :func:`tmem.engine.gas.clear`).
 
     Returns the largest squared shift of a flying agent's listed point (``P*``, or ``P`` with sensing)
     since the lists were built (0 without lists).
@@ -177,7 +177,6 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
     """
     box = run.box
     work = gas.work
-    kept = gas.kept
     c_max = gas.c_max
     n_axes = len(box)
     use_lists = run.use_lists
@@ -208,7 +207,7 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
                     delta = nearest_image((star if listed == 0 else position) - p_ref[i, a], box[a])
                     shift2 += delta * delta
             if observe:
-                clear(i, known, work, kept, c_max, n_axes, counting)
+                clear(i, known, work, n_axes, counting)
             if active[i]:
                 largest = max(largest, shift2)
         block_shift2[b] = largest
@@ -256,7 +255,7 @@ def record(agents, pairs, records, c_max, run, counters, gas, sensed):
         for m in range(agents.body.shape[1]):
             records.body[q_record, q, m] = agents.body[i, m]
         records.active[q_record, q] = agents.active[i]
-        scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas.observe, gas.kept, i, c_max)) if agents.active[i] else 0.0
+        scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas.observe, gas.limit, i, c_max)) if agents.active[i] else 0.0
         for a in range(n_axes):
             records.control[q_record, q, a] = agents.setpoint[i, a] * scale
     for e in range(pairs.i.shape[0]):

@@ -29,7 +29,7 @@ import numpy as np
 
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from ..control import saturation
-from .gas_columns import COMMON, CONTACT, LIMIT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
+from .gas_columns import COMMON, CONTACT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
 
 #: The common velocity's square counts as at least this share of the group's mean ``|V|^2`` (T3): a
 #: pair meeting head-on has no common motion to heat, and is left as it is, not pushed hard along a
@@ -50,7 +50,7 @@ def _common(i, a, known, work, per_contact):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def hold_group_push(i, known, work, kept, rate, target2, inv_g, n_axes):
+def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
     """At a count, agent ``i``'s push on its group (T3), kept until the next count.
 
     The group is half the agent, half the mean of its neighbours weighted by their contacts: the two
@@ -66,9 +66,9 @@ def hold_group_push(i, known, work, kept, rate, target2, inv_g, n_axes):
         The agent's slot.
     known : ndarray, shape (agents, axes, n_state)
         The states as known.
-    work, kept : ndarray
-        ``Gas.work``, with the count's sums (:mod:`tmem.engine.gas_columns`), and ``Gas.kept``,
-        changed in place.
+    work, held : ndarray
+        ``Gas.work``, with the count's sums, and ``Gas.held``, changed in place
+        (:mod:`tmem.engine.gas_columns`).
     rate : float
         ``1 / (2 tau)`` (1/s).
     target2 : float
@@ -87,13 +87,13 @@ def hold_group_push(i, known, work, kept, rate, target2, inv_g, n_axes):
         common2 += _common(i, a, known, work, per_contact) ** 2
     floor2 = max(common2, COMMON_FLOOR * group2)
     push = together * rate * (target2 - group2) * inv_g / floor2 if floor2 > 0.0 else 0.0
-    kept[i, TOGETHER] = together
+    held[i, TOGETHER] = together
     for a in range(n_axes):
-        kept[i, COMMON + a] = push * _common(i, a, known, work, per_contact)
+        held[i, COMMON + a] = push * _common(i, a, known, work, per_contact)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def add_thermostat_push(i, known, setpoint, kept, rate, target2, inv_g, c_max, n_axes):
+def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c_max, n_axes):
     """Add agent ``i``'s thermostat push to its set-point: its own part (T1), weighted by how far it is
     free, and its group's push held since the count (T3); the pushes summed before saturated at
     ``c_max`` first, the thermostat's push on its own.  Its tilt limit this step becomes the size of
@@ -107,8 +107,10 @@ def add_thermostat_push(i, known, setpoint, kept, rate, target2, inv_g, c_max, n
         The states as known.
     setpoint : ndarray, shape (agents, axes)
         The pushes summed, changed in place.
-    kept : ndarray
-        ``Gas.kept``: the group's push, and the tilt limit, written.
+    held : ndarray
+        ``Gas.held``: the group's push.
+    limit : ndarray, shape (agents,)
+        ``Gas.limit``: the agent's tilt limit this step, written.
     rate, target2, inv_g : float
         ``1 / (2 tau)`` (1/s), ``T*`` (m^2/s^2) and ``1 / g``.
     c_max : float
@@ -119,16 +121,16 @@ def add_thermostat_push(i, known, setpoint, kept, rate, target2, inv_g, c_max, n
     speed2 = 0.0
     for a in range(n_axes):
         speed2 += known[i, a, 1] * known[i, a, 1]
-    own = (1.0 - kept[i, TOGETHER]) * rate * (target2 / speed2 - 1.0) * inv_g if speed2 > 0.0 else 0.0
+    own = (1.0 - held[i, TOGETHER]) * rate * (target2 / speed2 - 1.0) * inv_g if speed2 > 0.0 else 0.0
     pushes2 = 0.0
     push2 = 0.0
     for a in range(n_axes):
         pushes2 += setpoint[i, a] * setpoint[i, a]
-        push2 += (own * known[i, a, 1] + kept[i, COMMON + a]) ** 2
+        push2 += (own * known[i, a, 1] + held[i, COMMON + a]) ** 2
     pushes_scale = saturation(pushes2, c_max)
     push_scale = saturation(push2, c_max)
     tilt2 = 0.0
     for a in range(n_axes):
-        setpoint[i, a] = pushes_scale * setpoint[i, a] + push_scale * (own * known[i, a, 1] + kept[i, COMMON + a])
+        setpoint[i, a] = pushes_scale * setpoint[i, a] + push_scale * (own * known[i, a, 1] + held[i, COMMON + a])
         tilt2 += setpoint[i, a] * setpoint[i, a]
-    kept[i, LIMIT] = max(c_max, np.sqrt(tilt2))
+    limit[i] = np.sqrt(tilt2) if tilt2 > c_max * c_max else c_max

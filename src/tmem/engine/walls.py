@@ -34,11 +34,21 @@ def _obstacle_gap(i, o, corrected, obstacles, box, n_axes):
 
 
 @numba.njit(cache=True, inline="always")
+def _first_push(pushed, i, contacts, n_axes):
+    """Clear ``pushed[i]`` before the first push of agent ``i``'s step (``contacts`` so far 0): an agent
+    out of every wall's reach, most of them, writes nothing."""
+    if contacts == 0:
+        for a in range(n_axes):
+            pushed[i, a] = 0.0
+
+
+@numba.njit(cache=True, inline="always")
 def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes):
     """The pushes (8) of the walls and obstacles within reach of agent ``i``'s ``P*`` (W1), summed into
-    ``pushed[i]``.  Return how many pushed; the sum of their squared sizes over ``c_max^2`` (C1); the
-    size of the box walls' pushes (rad) and their sum weighted by the agent's distance ``P`` from
-    each wall (rad m); and the obstacles' virial ``(P - c) . u`` about the box's centre ``c``.
+    ``pushed[i]`` (written only when one pushes).  Return how many pushed; the sum of their squared
+    sizes over ``c_max^2`` (C1); the size of the box walls' pushes (rad) and their sum weighted by the
+    agent's distance ``P`` from each wall (rad m); and the obstacles' virial ``(P - c) . u`` about the
+    box's centre ``c``.
 
     Parameters
     ----------
@@ -66,11 +76,11 @@ def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes
     obstacle_virial = 0.0
     reach = wall_params.reach
     for a in range(n_axes):
-        pushed[i, a] = 0.0
         if walls[a] > 0.0:
             low = corrected[i, a, 0]
             high = walls[a] - low
             if low < reach:  # the wall at 0 lies at d = -low: its push points along +a
+                _first_push(pushed, i, contacts, n_axes)
                 u = repulsion(max(low, 0.0), 0, wall_params)
                 pushed[i, a] -= u
                 on_walls -= u
@@ -78,6 +88,7 @@ def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes
                 contacts += 1
                 pressing += (u / wall_params.c_max) ** 2
             if high < reach:
+                _first_push(pushed, i, contacts, n_axes)
                 u = repulsion(max(high, 0.0), 0, wall_params)
                 pushed[i, a] += u
                 on_walls -= u
@@ -87,6 +98,7 @@ def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes
     for o in range(obstacles.shape[0]):
         centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
         if gap < reach and centre > 0.0:
+            _first_push(pushed, i, contacts, n_axes)
             u = repulsion(max(gap, 0.0), 0, wall_params)
             for a in range(n_axes):
                 along = u * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
