@@ -5,8 +5,9 @@ R + R_j on average, repulsion, dt = 0.01 s, 1000 steps, nothing recorded).  The 
 put the same agents in a walled box of the same side and hold them at their 3 m/s with the
 thermostat, which turns on every gas stage: the neighbour counts (every ``simulation.gas_period``,
 0.1 s: every 10th step), walls, thermostat and running totals; the last also averages their pushes
-(``interaction.combine = "mean"``).  ``--each`` adds each option on its own: the gas observed and
-nothing else, the periodic box with the mean of pushes, with the thermostat, and the walled box.
+(``interaction.combine = "mean"``).  ``--each`` adds walls and the thermostat with the gas counted
+at every step, and each option on its own: the gas observed and nothing else, the periodic box
+with the mean of pushes, with the thermostat, and the walled box.
 The cases alternate, after one compile run each; each figure is the median of ``--repeat`` runs, in
 agent-steps per second, and each ratio is that of the medians.
 
@@ -38,10 +39,11 @@ def with_options(n: int, *, mean: bool, steps: int = STEPS):
 
 
 def each_option(n: int) -> dict:
-    """gas-N with one option at a time."""
+    """gas-N with walls and the thermostat counted at every step, then with one option at a time."""
     plain = gas(n)
     walled = {"space.periodic": False, "space.walls": True}
-    return {"observe_gas": with_changes(plain, {"simulation.observe_gas": True}),
+    return {"walls + thermostat, counted every step": with_changes(with_options(n, mean=False), {"simulation.gas_period": DT}),
+            "observe_gas": with_changes(plain, {"simulation.observe_gas": True}),
             "periodic, mean of pushes": with_changes(plain, {"interaction.combine": "mean"}),
             "periodic, thermostat": with_changes(plain, {"thermostat": {"rms_velocity": 3.0}}),
             "walls": with_changes(plain, walled)}  # fmt: skip
@@ -69,7 +71,7 @@ def main() -> None:
         rates = {name: n * STEPS / statistics.median(s) for name, s in seconds.items()}
         ratios = {name: rate / rates["plain"] for name, rate in rates.items() if name != "plain"}
         for name, rate in rates.items():
-            print(f"N = {n:>8}  {name:<28} {rate:.3g} agent-steps/s  (runs: {', '.join(f'{s:.2f}' for s in seconds[name])} s)")
+            print(f"N = {n:>8}  {name:<38} {rate:.3g} agent-steps/s  (runs: {', '.join(f'{s:.2f}' for s in seconds[name])} s)")
         for name, ratio in ratios.items():
             print(f"N = {n:>8}  ratio ({name} / plain): {ratio:.3f}")
         rows.append({"n": n, "rates": rates, "seconds": seconds, "ratios": ratios})

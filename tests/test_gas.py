@@ -277,6 +277,46 @@ def test_both_agents_of_a_pair_get_the_same_thermostat_push():
     assert np.linalg.norm(rest[full, 0], axis=1).max() > 0.005
 
 
+def _bounce_at_an_angle(obstacle: bool, thermostat: dict | None):
+    """An agent at 4 m/s meeting a wall (or an obstacle) 40 degrees from its normal; the closest its
+    position comes to the surface, and its largest speed across its way in."""
+    turn = math.radians(40.0)
+    data = {
+        "name": "bounce", "space": {"axes": 2, "walls": True, "box": [1000.0, 1000.0]},
+        "interaction": {"function": "repulsion"},
+        "simulation": {"dt": 0.01, "duration": 150.0, "record_every": 1},
+        "agents": [{"position": [200.0, 300.0], "velocity": [-4.0 * math.cos(turn), 4.0 * math.sin(turn)]},
+                   {"position": [900.0, 900.0], "velocity": [0.0, 0.0]}],
+    }  # fmt: skip
+    if obstacle:
+        data["space"]["box"] = [3000.0, 3000.0]
+        data["agents"] = [{"position": [1500.0, 1500.0], "velocity": [-4.0, 0.0]},
+                          {"position": [2900.0, 2900.0], "velocity": [0.0, 0.0]}]  # fmt: skip
+        data["obstacles"] = [{"center": [1000.0, 1500.0 + 192.0 * math.sin(turn)], "radius": 200.0}]
+    if thermostat is not None:
+        data["thermostat"] = thermostat
+    tr = tmem.simulate(from_dict(data))
+    places, velocities = tr.state[:, 0, :, 0], tr.state[:, 0, :, 1]
+    if obstacle:
+        gap = np.linalg.norm(places - np.array(data["obstacles"][0]["center"]), axis=1) - 200.0
+        return gap.min(), np.abs(velocities[:, 1]).max()
+    return places[:, 0].min(), np.abs(velocities[:, 1]).max()
+
+
+@pytest.mark.parametrize("obstacle", [False, True], ids=["wall", "obstacle"])
+def test_the_thermostat_leaves_a_bounce_as_the_repulsion_makes_it(obstacle):
+    """An agent meeting a wall 40 degrees from its normal, the thermostat holding its 4 m/s: within the
+    wall's reach the thermostat moves it only along the wall, so it comes as close to the wall as
+    with the thermostat off (to 1e-9 m: the axes of a box are apart), while the thermostat makes up
+    what the bounce holds along the wall (its speed along the wall rises).  Off an obstacle, whose
+    normal turns as the agent moves along it, within 0.02 m."""
+    alone, along_alone = _bounce_at_an_angle(obstacle, None)
+    for tau in (0.5, 1.0, 5.0):
+        closest, along = _bounce_at_an_angle(obstacle, {"rms_velocity": 4.0, "tau": tau})
+        assert closest == pytest.approx(alone, abs=0.02 if obstacle else 1e-9), tau
+        assert along > along_alone + 0.01, tau
+
+
 @pytest.mark.parametrize("neighbours", [1.0, 6.0, 12.0])
 def test_the_thermostat_holds_a_gas_at_every_density(neighbours):
     """gas_thermostat.toml at 1, 6 and 12 neighbours within R + R_j on average, run for 120 s: from 3
