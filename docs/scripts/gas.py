@@ -29,7 +29,7 @@ import tmem  # noqa: E402
 from tmem.control import modal_gains  # noqa: E402
 from tmem.model.linear import state_matrices  # noqa: E402
 from tmem.observables import gas_summary, temperature  # noqa: E402
-from tmem.scenario import from_dict  # noqa: E402
+from tmem.scenario import from_dict, with_changes  # noqa: E402
 
 OUT = Path(__file__).resolve().parent.parent / "gas"
 EXAMPLES = Path(__file__).resolve().parent.parent.parent / "examples" / "swarm"
@@ -227,6 +227,9 @@ def pressure() -> None:
     walls, virial, wall_range = s["pressure_walls"], s["pressure_virial"], s["pressure_wall_range"]
     print(f"\n(G1) + (G3) against (G2): {100 * ((virial + wall_range) / walls - 1):+.2f} %; "
           f"(G1) alone: {100 * (virial / walls - 1):+.2f} %")  # fmt: skip
+    slow = gas_summary(tmem.simulate(with_changes(tmem.load(EXAMPLES / "gas_box.toml"), {"thermostat.tau": 5.0})), since=20.0)
+    print(f"(G2) over the ideal gas's: {walls / s['pressure_ideal']:.3f} at tau = 1 s, "
+          f"{slow['pressure_walls'] / slow['pressure_ideal']:.3f} at tau = 5 s (RMS {slow['rms_velocity']:.4f} m/s)")
 
 
 def equation_of_state() -> None:
@@ -266,6 +269,10 @@ def field() -> None:
     tr = tmem.simulate(tmem.load(EXAMPLES / "field.toml"))
     field_figure(tr).savefig(OUT / "field.png", dpi=110)
     print("\nfield.toml:", coverage_summary(tr), "breaches:", gas_summary(tr)["breaches"])
+    for seconds in (0.1, 10.0, 50.0):  # how much coverage records far apart lose
+        few = with_changes(tmem.load(EXAMPLES / "field.toml"), {"swarm.n": 20, "simulation.record_every": round(seconds / 0.01)})
+        print(f"field.toml with 20 agents, recorded every {seconds:g} s: "
+              f"{100 * coverage_summary(tmem.simulate(few))['share_final']:.1f} % covered")
 
 
 def coverage(directory: str) -> None:
