@@ -263,6 +263,9 @@ def _local_client(workers: int | None) -> Iterator:
         try:
             cluster.close()
         except TimeoutError:  # a worker too slow to answer (a loaded or paused machine): its rows are saved
+            for nanny in getattr(cluster, "workers", {}).values():  # a nanny would start a killed worker again
+                if hasattr(nanny, "close_gracefully"):
+                    nanny.close_gracefully(reason="the cluster did not close in time")
             for worker in set(multiprocessing.active_children()) - before:  # none may outlive the command
                 worker.kill()
                 worker.join(timeout=5)
