@@ -16,6 +16,7 @@ import pytest
 
 import tmem
 from tmem.control import interaction_point, modal_gains
+from tmem.engine.gas import TOTALS
 from tmem.interaction.kernels import evaluate
 from tmem.model.linear import state_matrices
 from tmem.observables import gas_summary, temperature
@@ -320,18 +321,17 @@ def test_the_thermostat_leaves_a_bounce_as_the_repulsion_makes_it(obstacle):
 @pytest.mark.parametrize("neighbours", [1.0, 6.0, 12.0])
 def test_the_thermostat_holds_a_gas_at_every_density(neighbours):
     """gas_thermostat.toml at 1, 6 and 12 neighbours within R + R_j on average, run for 120 s: from 3
-    to 4 m/s within 5 % in at most 30 s of the command at 30 s, then from 60 s on the RMS velocity of
-    the agents' velocities stays within 2 % of 4 m/s and its mean within 0.5 %.  At one neighbour 4
-    to 5 agents in 10 are within reach of another at any time."""
+    to 4 m/s within 5 % in at most 5 s of the command at 30 s (1.2 to 1.8 s over twelve seeds, against
+    30 s asked), then from 60 s on the RMS velocity of the agents' velocities stays within 2 % of
+    4 m/s and its mean within 0.5 %."""
     data = tmem.load(EXAMPLES / "gas_thermostat.toml").model_dump(mode="json", exclude_none=True)
     side = math.sqrt(400 * math.pi * 40.0**2 / neighbours)
     data["space"]["box"] = [side, side]
     data["simulation"].update(duration=120.0, record_every=10)
     tr = tmem.simulate(from_dict(data))
     rms = np.sqrt((tr.state[:, :, :, 1] ** 2).sum(axis=-1).mean(axis=1))  # from the states, not the totals
-    after = tr.time >= 30.0
-    reached = tr.time[after][np.argmax(np.abs(rms[after] / 4.0 - 1.0) <= 0.05)]
-    assert reached - 30.0 <= 30.0
+    within = (np.abs(rms / 4.0 - 1.0) <= 0.05) & (tr.time >= 30.0)
+    assert within.any() and tr.time[np.argmax(within)] - 30.0 <= 5.0
     held = tr.time >= 60.0
     assert np.abs(rms[held] / 4.0 - 1.0).max() < 0.02
     assert abs(rms[held].mean() / 4.0 - 1.0) < 0.005
@@ -450,6 +450,26 @@ def test_the_walls_pressure_obeys_the_virial_theorem(obstacles):
     assert gas["pressure_virial"] + gas["pressure_wall_range"] == pytest.approx(gas["pressure_walls"], rel=0.01)
     assert gas["pressure_virial"] == pytest.approx(gas["pressure_walls"], rel=0.05)
     assert gas["pressure_walls"] > 1.2 * gas["pressure_ideal"]  # the pushes add to the kinetic pressure
+
+
+def test_the_virial_takes_the_pushes_as_saturated_with_the_thermostat_on():
+    """Three agents at rest in a periodic box, agent 0 pushed by the other two at right angles with
+    c_max each, so that its summed push saturates: at rest the thermostat pushes no one, and the
+    virial (G1) of the first step is the same with it on as off, where the vehicle's step saturates
+    the pushes.  (With the thermostat on, the pushes are saturated in the gas's stage.)"""
+    data = {
+        "name": "three", "space": {"axes": 2, "periodic": True, "box": [1000.0, 1000.0]},
+        "interaction": {"function": "repulsion"},
+        "simulation": {"dt": 0.01, "duration": 0.02, "record_every": 1, "observe_gas": True},
+        "agents": [{"position": [500.0, 500.0]}, {"position": [510.0, 500.0]}, {"position": [500.0, 510.0]}],
+    }  # fmt: skip
+    off = tmem.simulate(from_dict(data))
+    on = tmem.simulate(from_dict({**data, "thermostat": {"rms_velocity": 3.0}}))
+    np.testing.assert_array_equal(on.control[0], off.control[0])
+    assert np.linalg.norm(off.control[0, 0]) == pytest.approx(0.1, rel=1e-12)  # saturated
+    virial = TOTALS.index("virial")
+    assert on.gas[1, virial] == pytest.approx(off.gas[1, virial], rel=1e-12)
+    assert off.gas[1, virial] != 0.0
 
 
 def test_neighbours_at_the_start_are_not_encounters():

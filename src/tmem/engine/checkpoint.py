@@ -66,6 +66,7 @@ FIXED_RECORDS = (Run, Law, FunctionParams, Commands)
 
 _FIXED = "a number fixed for the run, made again from the scenario"
 _WORK = "work space, written at every step before it is read"
+_COUNTED = "work space, written at each count of the gas before it is read"
 _LISTED = "the neighbour lists, listed again from neighbours.p_ref and the flying agents as at their last build"
 #: The fields of :data:`CHANGING` records that a checkpoint does not hold, and why each is made again exactly.
 REBUILT = {
@@ -76,7 +77,7 @@ REBUILT = {
     },
     "gas": {
         **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "every", "wall_reach", "c_max"), _FIXED),
-        "work": _WORK, "pushed": _WORK, "surface_push": _WORK,
+        "work": _COUNTED, "pushed": _WORK, "surface_push": _WORK,
     },
     "sensing": {
         **dict.fromkeys((f for f in Sensing._fields if f not in ("history", "own", "pair_states", "pushes", "work")), _FIXED),

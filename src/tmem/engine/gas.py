@@ -186,10 +186,11 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, f
         gas.near_before[i] = work[i, NEAR]
         if thermostat:
             hold_group_push(i, known, work, gas.held, gas.rate, gas.target2[0], gas.inv_g, n_axes)
+    pushes_scale = 1.0  # the factor that saturated the pushes here, not in the vehicle's step
     if thermostat:
         surfaces = (corrected, gas.surface_push, walls, obstacles, box, wall_params.reach, contacts > 0)
-        add_thermostat_push(i, known, setpoint, gas.held, limit, gas.rate, gas.target2[0], gas.inv_g, gas.c_max, n_axes,
-                            surfaces)  # fmt: skip
+        pushes_scale = add_thermostat_push(i, known, setpoint, gas.held, limit, gas.rate, gas.target2[0], gas.inv_g,
+                                           gas.c_max, n_axes, surfaces)  # fmt: skip
     else:
         limit[i] = gas.c_max
     if counting and not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
@@ -197,8 +198,8 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, f
         for a in range(n_axes):
             own += (corrected[i, a, 1] - 0.5 * walls[a]) * setpoint[i, a]
         work[i, VIRIAL] = own
-    elif counting:  # each pair's half
-        work[i, VIRIAL] *= 0.5
+    elif counting:  # each pair's half, of the pushes as saturated
+        work[i, VIRIAL] *= 0.5 * pushes_scale
     if contacts > 0:  # what the walls drop of the others becomes the walls' own push (W2)
         held, held_moment, dropped_virial = keep_off(i, corrected, setpoint, walls, obstacles, box, wall_params.reach,
                                                       n_axes)  # fmt: skip
@@ -297,7 +298,8 @@ def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sa
     n_axes : int
         Number of axes.
     sampled : int
-        The steps a count stands for (``Gas.every``); 0 at a step that is not a count.
+        The steps a count stands for (``Gas.every``, or those left in the run at its last count); 0 at
+        a step that is not a count.
     """
     if sampled > 0:
         totals[i, VIRIAL_TOTAL] += sampled * scale * g_dt * work[i, VIRIAL]
@@ -374,7 +376,7 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         inv_g=1.0 / acceleration_per_tilt,
         g_dt=acceleration_per_tilt * dt,
         dt=dt,
-        every=max(1, round(scenario.simulation.gas_period / dt)),
+        every=max(1, int(scenario.simulation.gas_period / dt + 0.5)),  # the nearest whole number of steps
         walls=walls,
         obstacles=obstacles,
         wall_reach=scenario.wall_reach,

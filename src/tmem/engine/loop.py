@@ -104,6 +104,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
         if is_recorded(k, run):
             record(agents, pairs, records, c_max, run, counters, gas, SENSED)
         if k < run.n_steps:
+            sampled = min(every, run.n_steps - k) if counting else 0  # the steps this count stands for
             for i in numba.prange(x.shape[0]):
                 if active[i]:
                     scale = tilt_scale(u, i, n_axes, tilt_limit(observe, limit, i, c_max))
@@ -112,7 +113,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
                             x[i, a, 0] = into_box(x[i, a, 0], box[a])
                     if observe:
-                        tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, every if counting else 0)
+                        tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sampled)
     counters.step[0] = k_stop
     return DONE
 

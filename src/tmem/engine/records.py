@@ -269,7 +269,7 @@ class Gas(NamedTuple):
         The scenario's tilt limit (rad).
     first : ndarray, shape (1,), bool
         True until the first step's neighbours are counted: they are not encounters.
-    work : ndarray, shape (agents, 7 + axes) (no rows when not observed)
+    work : ndarray, shape (agents, 5 + axes) (no rows when not observed)
         Each agent's work space of a count, in the columns :data:`tmem.engine.gas_columns.NEAR` ...
         :data:`tmem.engine.gas_columns.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's
         counts touch two rows.

@@ -132,6 +132,11 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
                         agents.state[i, a, m] = agents.start[i, a, m]
                 for m in range(agents.body.shape[1]):
                     agents.body[i, m] = agents.body_start[i, m]
+                if gas.observe:  # what its last count set is stale: it starts as a free agent
+                    gas.weight[i] = 1.0
+                    gas.near_before[i] = 0.0
+                    for c in range(gas.held.shape[1]):
+                        gas.held[i, c] = 0.0
             else:
                 agents.state[i, :, 1:] = 0.0
             log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind, -1)

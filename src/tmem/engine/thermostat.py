@@ -102,8 +102,10 @@ def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c
     """Add agent ``i``'s thermostat push to its set-point: its own part (T1), weighted by how far it is
     free, and its group's push held since the count (T3); the pushes summed before saturated at
     ``c_max`` first, the thermostat's push on its own.  Within a wall's or an obstacle's reach, only
-    its part along their surfaces.  Its tilt limit this step becomes the size of the sum, so that
-    nothing saturates it again.
+    its part along their surfaces.  Its tilt limit this step becomes the size of the sum, so that the
+    vehicle's step does not saturate it again (within a wall's reach the walls' last word, W2, then
+    fits the sum into what they leave, :func:`tmem.engine.walls.with_priority`).  Return the factor
+    that saturated the pushes.
 
     Parameters
     ----------
@@ -150,3 +152,4 @@ def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c
         setpoint[i, a] = pushes_scale * setpoint[i, a] + thermostat
         tilt2 += setpoint[i, a] * setpoint[i, a]
     limit[i] = np.sqrt(tilt2) if tilt2 > c_max * c_max else c_max
+    return pushes_scale
