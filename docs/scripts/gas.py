@@ -3,7 +3,7 @@
 Prints Markdown tables to standard output and writes ``docs/gas/roots.png``,
 ``docs/gas/equation_of_state.png`` and ``docs/gas/field.png``::
 
-    python docs/scripts/gas.py            # about 15 minutes on 2 cores
+    python docs/scripts/gas.py            # about 25 minutes on 2 cores
 
 and, from the coverage sweep's results, the coverage table::
 
@@ -160,10 +160,30 @@ def thermostat() -> None:
                   f"{max(largest):.2f} % | {min(bias):+.2f} to {max(bias):+.2f} % | {min(std):.2f}-{max(std):.2f} % |",
                   flush=True)  # fmt: skip
     tr = _thermostat_run(1.0, 1, 1.0)
-    speeds = np.linalg.norm(tr.state[tr.time >= 60.0, :, :, 1], axis=-1).ravel()
+    held = tr.time >= 60.0
+    speeds = np.linalg.norm(tr.state[held, :, :, 1], axis=-1).ravel()
     low, high = np.percentile(speeds, [5, 95])
     print(f"\none neighbour, tau = 1 s, seed 1, 60-120 s: 5-95 % of speeds within {low:.2f}-{high:.2f} m/s; "
           f"Maxwell's 2-D distribution at 4 m/s RMS: {4 * math.sqrt(-math.log(0.95)):.2f}-{4 * math.sqrt(math.log(20)):.2f} m/s")
+    side = math.sqrt(400 * math.pi * 40.0**2)
+    near = _in_reach(tr, side)[held].mean(axis=1)
+    print(f"agents within reach of another, 60-120 s: {100 * near.min():.0f}-{100 * near.max():.0f} %")
+    print("\nsummed pushes, tau = 1 s, largest error 60-120 s, seeds 1 / 2 / 3:")
+    for n in (6.0, 12.0):
+        errors = []
+        for seed in (1, 2, 3):
+            data = tmem.load(EXAMPLES / "gas_thermostat.toml").model_dump(mode="json", exclude_none=True)
+            data["space"]["box"] = [math.sqrt(400 * math.pi * 40.0**2 / n)] * 2
+            data["swarm"]["seed"] = seed
+            data["interaction"]["combine"] = "sum"
+            data["simulation"].update(duration=120.0, record_every=10)
+            run = tmem.simulate(from_dict(data))
+            errors.append(100 * np.abs(temperature(run)[run.time >= 60.0] / 4.0 - 1.0).max())
+        print(f"  {n:g} neighbours: " + " / ".join(f"{e:.2f} %" for e in errors))
+    for tau in (0.05, 0.1, 0.2, 0.4, 0.6, 0.8, 1.0, 2.0):  # a lone agent's speed loop, linearised (Routh-Hurwitz)
+        roots = np.roots([tau, KD * tau, KP * KD * tau, KP * KD])
+        print(f"tau = {tau:g} s: roots of tau s^3 + kd tau s^2 + kp kd tau s + kp kd: "
+              + ", ".join(f"{z.real:.3g}{z.imag:+.3g}i" for z in roots))
 
 
 def _encounter(speed: float, angle: float, offset: float, tau: float | None) -> float:
@@ -180,6 +200,16 @@ def _encounter(speed: float, angle: float, offset: float, tau: float | None) -> 
         data["thermostat"] = {"rms_velocity": speed, "tau": tau}
     places = tmem.simulate(from_dict(data)).state[:, :, :, 0]
     return float(np.linalg.norm(places[:, 0] - places[:, 1], axis=1).min())
+
+
+def _in_reach(trajectory, side: float) -> np.ndarray:
+    """Whether each agent has another within R + R_j = 40 m, at each record (nearest periodic image)."""
+    from scipy.spatial import cKDTree
+
+    near = np.zeros(trajectory.state.shape[:2], dtype=bool)
+    for k, places in enumerate(np.mod(trajectory.state[:, :, :, 0], side)):
+        near[k, cKDTree(places, boxsize=side).query_pairs(40.0, output_type="ndarray").ravel()] = True
+    return near
 
 
 def head_on() -> None:

@@ -43,7 +43,7 @@ COMMON_FLOOR = 0.25
 #: Contacts from which an agent's thermostat pushes its group alone (T3): a push a third of ``c_max``
 #: (``sqrt(0.1)``).  Until then the agent is pushed along its own velocity too, each of a pair
 #: differently; the blend is over before the encounter has slowed the pair, so that it leaves their
-#: closest approach within 0.01 m of the repulsion's alone (at 1 to 6 m/s, tau from 0.2 s up).
+#: closest approach within 0.01 m of the repulsion's alone (``docs/gas.md``, section 2).
 FULL_CONTACT = 0.1
 
 
