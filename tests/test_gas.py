@@ -280,7 +280,7 @@ def test_both_agents_of_a_pair_get_the_same_thermostat_push():
 
 def _bounce_at_an_angle(obstacle: bool, thermostat: dict | None):
     """An agent at 4 m/s meeting a wall (or an obstacle) 40 degrees from its normal; the closest its
-    position comes to the surface, and its largest speed across its way in."""
+    position comes to the surface, and its speed at the end."""
     turn = math.radians(40.0)
     data = {
         "name": "bounce", "space": {"axes": 2, "walls": True, "box": [1000.0, 1000.0]},
@@ -297,25 +297,24 @@ def _bounce_at_an_angle(obstacle: bool, thermostat: dict | None):
     if thermostat is not None:
         data["thermostat"] = thermostat
     tr = tmem.simulate(from_dict(data))
-    places, velocities = tr.state[:, 0, :, 0], tr.state[:, 0, :, 1]
+    places, final_speed = tr.state[:, 0, :, 0], float(np.linalg.norm(tr.state[-1, 0, :, 1]))
     if obstacle:
-        gap = np.linalg.norm(places - np.array(data["obstacles"][0]["center"]), axis=1) - 200.0
-        return gap.min(), np.abs(velocities[:, 1]).max()
-    return places[:, 0].min(), np.abs(velocities[:, 1]).max()
+        return (np.linalg.norm(places - np.array(data["obstacles"][0]["center"]), axis=1) - 200.0).min(), final_speed
+    return places[:, 0].min(), final_speed
 
 
 @pytest.mark.parametrize("obstacle", [False, True], ids=["wall", "obstacle"])
 def test_the_thermostat_leaves_a_bounce_as_the_repulsion_makes_it(obstacle):
-    """An agent meeting a wall 40 degrees from its normal, the thermostat holding its 4 m/s: within the
-    wall's reach the thermostat moves it only along the wall, so it comes as close to the wall as
-    with the thermostat off (to 1e-9 m: the axes of a box are apart), while the thermostat makes up
-    what the bounce holds along the wall (its speed along the wall rises).  Off an obstacle, whose
-    normal turns as the agent moves along it, within 0.02 m."""
-    alone, along_alone = _bounce_at_an_angle(obstacle, None)
+    """An agent meeting a wall or an obstacle 40 degrees from its normal, the thermostat holding its
+    4 m/s: within their reach the thermostat leaves it alone, so it comes as close as with the
+    thermostat off (to 1e-9 m); once free, the thermostat takes off what the bounce added (the
+    repulsion's bounce leaves it 0.2 % faster, the thermostat within 0.01 % of 4 m/s)."""
+    alone, speed_alone = _bounce_at_an_angle(obstacle, None)
+    assert speed_alone > 4.005
     for tau in (0.5, 1.0, 5.0):
-        closest, along = _bounce_at_an_angle(obstacle, {"rms_velocity": 4.0, "tau": tau})
-        assert closest == pytest.approx(alone, abs=0.02 if obstacle else 1e-9), tau
-        assert along > along_alone + 0.01, tau
+        closest, speed = _bounce_at_an_angle(obstacle, {"rms_velocity": 4.0, "tau": tau})
+        assert closest == pytest.approx(alone, abs=1e-9), tau
+        assert speed == pytest.approx(4.0, rel=1e-4), tau
 
 
 @pytest.mark.parametrize("neighbours", [1.0, 6.0, 12.0])
@@ -410,10 +409,16 @@ def _encounters_with_surfaces(tr, scenario) -> int:
     return count
 
 
-def test_no_agent_passes_a_wall_or_an_obstacle():
+@pytest.mark.parametrize("thermostat", [False, True], ids=["alone", "thermostat"])
+def test_no_agent_passes_a_wall_or_an_obstacle(thermostat):
     """About 10^4 encounters with walls and obstacles near the fastest speed the tilt limit can stop:
-    no recorded step puts an agent beyond a wall or inside an obstacle, and the engine counts none."""
+    no recorded step puts an agent beyond a wall or inside an obstacle, and the engine counts none;
+    the same with the thermostat holding that speed (it leaves agents within a wall's reach alone:
+    heating them along one wall drove them through the next in a corner, 1.4 10^5 agent-steps
+    beyond a wall in this run)."""
     scenario = _arena(600, 400.0, seed=1)
+    if thermostat:
+        scenario = tmem.scenario.with_changes(scenario, {"thermostat": {"rms_velocity": 8.4, "tau": 1.0}})
     tr = tmem.simulate(scenario)
     assert _encounters_with_surfaces(tr, scenario) > 8000
     assert _breaches(tr, scenario) == 0

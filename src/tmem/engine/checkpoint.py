@@ -77,7 +77,7 @@ REBUILT = {
     },
     "gas": {
         **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "every", "wall_reach", "c_max"), _FIXED),
-        "work": _COUNTED, "pushed": _WORK, "surface_push": _WORK,
+        "work": _COUNTED, "pushed": _WORK,
     },
     "sensing": {
         **dict.fromkeys((f for f in Sensing._fields if f not in ("history", "own", "pair_states", "pushes", "work")), _FIXED),

@@ -187,10 +187,9 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, f
         if thermostat:
             hold_group_push(i, known, work, gas.held, gas.rate, gas.target2[0], gas.inv_g, n_axes)
     pushes_scale = 1.0  # the factor that saturated the pushes here, not in the vehicle's step
-    if thermostat:
-        surfaces = (corrected, gas.surface_push, walls, obstacles, box, wall_params.reach, contacts > 0)
+    if thermostat and contacts == 0:  # within a wall's reach, the wall's bounce is left as it is
         pushes_scale = add_thermostat_push(i, known, setpoint, gas.held, limit, gas.rate, gas.target2[0], gas.inv_g,
-                                           gas.c_max, n_axes, surfaces)  # fmt: skip
+                                           gas.c_max, n_axes)  # fmt: skip
     else:
         limit[i] = gas.c_max
     if counting and not virial_by_pairs(walls):  # the virial of every push but the walls', about the box's centre (G1)
@@ -388,6 +387,5 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         limit=np.zeros(size),
         held=np.zeros((size, COMMON + space.axes)),
         pushed=np.zeros((size, space.axes)),
-        surface_push=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),
     )

@@ -286,9 +286,6 @@ class Gas(NamedTuple):
         :mod:`tmem.engine.gas_columns` (T3).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
-    surface_push : ndarray, shape (agents, axes)
-        Work space: the thermostat's push of an agent within a wall's or an obstacle's reach, along
-        their surfaces (:func:`tmem.engine.walls.along_surfaces`).
     totals : ndarray, shape (agents, 6)
         Each agent's running totals, in the order of :data:`tmem.engine.gas.TOTALS`.
     """
@@ -312,7 +309,6 @@ class Gas(NamedTuple):
     limit: np.ndarray
     held: np.ndarray
     pushed: np.ndarray
-    surface_push: np.ndarray
     totals: np.ndarray
 
 

@@ -16,10 +16,9 @@ own state and the velocities of the neighbours it counts.
 * **The pushes come first.**  The pushes summed before are saturated at ``c_max`` on their own, and
   the thermostat's push on its own, then the two are added: a pair's pushes stay equal and
   opposite whatever the thermostat does, and the tilt may reach ``2 c_max``.
-* **Walls and obstacles are left their bounces.**  Within a wall's or an obstacle's reach, the
-  thermostat's push along its normal is dropped (:func:`tmem.engine.walls.along_surfaces`): a wall
-  is a neighbour held still, whose common motion with the agent is none, so the thermostat moves
-  the agent only along the surface.
+* **Walls and obstacles are left their bounces.**  A wall is a neighbour held still, which shares
+  no common motion with the agent: within a wall's or an obstacle's reach the thermostat does not
+  push the agent at all (:func:`tmem.engine.gas.gas_pushes`).
 
 The group's push (T3) is found at each count (:func:`hold_group_push`) from the neighbours counted
 then, and held until the next; the free agent's part (T1) follows its velocity at every step
@@ -34,7 +33,6 @@ import numpy as np
 from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from ..control import saturation
 from .gas_columns import COMMON, CONTACT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
-from .walls import along_surfaces
 
 #: The common velocity's square counts as at least this share of the group's mean ``|V|^2`` (T3): a
 #: pair meeting head-on has no common motion to heat, and is left as it is, not pushed hard along a
@@ -98,14 +96,12 @@ def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c_max, n_axes, surfaces):
+def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c_max, n_axes):
     """Add agent ``i``'s thermostat push to its set-point: its own part (T1), weighted by how far it is
     free, and its group's push held since the count (T3); the pushes summed before saturated at
-    ``c_max`` first, the thermostat's push on its own.  Within a wall's or an obstacle's reach, only
-    its part along their surfaces.  Its tilt limit this step becomes the size of the sum, so that the
-    vehicle's step does not saturate it again (within a wall's reach the walls' last word, W2, then
-    fits the sum into what they leave, :func:`tmem.engine.walls.with_priority`).  Return the factor
-    that saturated the pushes.
+    ``c_max`` first, the thermostat's push on its own.  Its tilt limit this step becomes the size of
+    the sum, so that the vehicle's step does not saturate it again.  Return the factor that saturated
+    the pushes.
 
     Parameters
     ----------
@@ -125,10 +121,6 @@ def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c
         The scenario's tilt limit (rad).
     n_axes : int
         Number of axes.
-    surfaces : tuple
-        ``(corrected, push, walls, obstacles, box, reach, within)``: what
-        :func:`tmem.engine.walls.along_surfaces` takes, ``push`` its work space, and whether the
-        agent is within reach of a wall or an obstacle.
     """
     speed2 = 0.0
     for a in range(n_axes):
@@ -141,15 +133,9 @@ def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c
         push2 += (own * known[i, a, 1] + held[i, COMMON + a]) ** 2
     pushes_scale = saturation(pushes2, c_max)
     push_scale = saturation(push2, c_max)
-    corrected, push, walls, obstacles, box, reach, within = surfaces
-    if within:
-        for a in range(n_axes):
-            push[i, a] = push_scale * (own * known[i, a, 1] + held[i, COMMON + a])
-        along_surfaces(i, corrected, push, walls, obstacles, box, reach, n_axes)
     tilt2 = 0.0
     for a in range(n_axes):
-        thermostat = push[i, a] if within else push_scale * (own * known[i, a, 1] + held[i, COMMON + a])
-        setpoint[i, a] = pushes_scale * setpoint[i, a] + thermostat
+        setpoint[i, a] = pushes_scale * setpoint[i, a] + push_scale * (own * known[i, a, 1] + held[i, COMMON + a])
         tilt2 += setpoint[i, a] * setpoint[i, a]
     limit[i] = np.sqrt(tilt2) if tilt2 > c_max * c_max else c_max
     return pushes_scale

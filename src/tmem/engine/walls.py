@@ -110,44 +110,6 @@ def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes
 
 
 @numba.njit(cache=True, inline="always")
-def along_surfaces(i, corrected, push, walls, obstacles, box, reach, n_axes):
-    """Drop from ``push[i]`` its part along the normal of every wall and obstacle within reach of
-    agent ``i``'s ``P*``, into it or out of it: what is left moves the agent along their surfaces and
-    leaves its bounces as the repulsion makes them (the thermostat's push, :mod:`tmem.engine.thermostat`).
-
-    Parameters
-    ----------
-    i : int
-        The agent's slot.
-    corrected : ndarray, shape (agents, axes, 2)
-        Each agent's ``(P*, P)`` per axis (``Agents.corrected``).
-    push : ndarray, shape (agents, axes)
-        The push, changed in place for agent ``i``.
-    walls : ndarray, shape (axes,)
-        The walled box's sides (0: no walls on that axis; the box spans ``[0, side]``).
-    obstacles : ndarray, shape (obstacles, axes + 1)
-        Each obstacle's centre and radius (m).
-    box : tuple of float
-        The periodic box's sides (0: open axis).
-    reach : float
-        ``R + R_w`` (m).
-    n_axes : int
-        Number of axes.
-    """
-    for a in range(n_axes):
-        if walls[a] > 0.0 and (corrected[i, a, 0] < reach or walls[a] - corrected[i, a, 0] < reach):
-            push[i, a] = 0.0
-    for o in range(obstacles.shape[0]):
-        centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
-        if gap < reach and centre > 0.0:
-            normal = 0.0
-            for a in range(n_axes):
-                normal += push[i, a] * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
-            for a in range(n_axes):
-                push[i, a] -= normal * nearest_image(obstacles[o, a] - corrected[i, a, 0], box[a]) / centre
-
-
-@numba.njit(cache=True, inline="always")
 def keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes):
     """Drop from agent ``i``'s other pushes the part that points into a wall or an obstacle within
     reach of its ``P*`` (W2): neighbours, formation pulls and the thermostat never push it through.

@@ -24,9 +24,9 @@ WORK_BYTES_PER_AGENT_AXIS = 128
 WORK_BYTES_PER_AGENT = 256
 #: Bytes of the gas's work space per agent and per agent and axis, when it is observed
 #: (:class:`tmem.engine.records.Gas`: 15 numbers, and on each axis its neighbours' velocity, the
-#: thermostat's held push, its push along walls and the walls' push).
+#: thermostat's held push and the walls' push).
 GAS_BYTES_PER_AGENT = 120
-GAS_BYTES_PER_AGENT_AXIS = 32
+GAS_BYTES_PER_AGENT_AXIS = 24
 #: Bytes per tracked pair while running (flag, distances, both directions of the edge), rounded up.
 WORK_BYTES_PER_PAIR = 96
 
