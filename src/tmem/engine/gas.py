@@ -64,7 +64,7 @@ SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
 
 
 @numba.njit(cache=True, inline="always")
-def clear(i, known, work, n_axes, counting):
+def clear(i, known, work, n_axes):
     """Start agent ``i``'s count: nothing counted yet, and its own ``|V|^2`` as known.
 
     Called in a parallel loop: it takes the record's arrays, not the record.
@@ -79,11 +79,7 @@ def clear(i, known, work, n_axes, counting):
         ``Gas.work`` (:class:`tmem.engine.records.Gas`), changed in place.
     n_axes : int
         Number of axes.
-    counting : bool
-        Whether the step is a count: at other steps nothing is done.
     """
-    if not counting:
-        return
     speed2 = 0.0
     for a in range(n_axes):
         speed2 += known[i, a, 1] * known[i, a, 1]

@@ -87,7 +87,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
         known = x
         if SENSED:
             known = measure(k, x, sensing)
-        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, listed, observe, counting)
+        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, listed, counting)
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
             for i in range(x.shape[0]):
                 for a in range(n_axes):

@@ -68,26 +68,19 @@ def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, c
             nearest2 = min(nearest2, chunks[w, 2 * n_axes, t])
         if counting:
             _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known)
-        elif gas.mean:
-            _add_weighted(chunks, w, m, pairs, begin, n_axes, u, gas.weight)
         else:
-            for t in range(m):
-                i = pairs[begin + t, 0]
-                j = pairs[begin + t, 1]
-                for a in range(n_axes):
-                    u[i, a] += chunks[w, a, t]
-                    u[j, a] -= chunks[w, a, t]
+            _add_pushes(chunks, w, m, pairs, begin, n_axes, u, gas.weight, gas.mean)
     return nearest2
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _add_weighted(chunks, w, m, pairs, begin, n_axes, u, weight):
-    """Add a chunk's pushes to ``u`` as :func:`_pushes_of` does, each divided by
-    :func:`tmem.engine.gas.pair_share`, the weight its agents broadcast at the last count (C1)."""
+def _add_pushes(chunks, w, m, pairs, begin, n_axes, u, weight, mean):
+    """Add a chunk's pushes to ``u``, equal and opposite; under the mean of pushes (``mean``, C1) each
+    divided by :func:`tmem.engine.gas.pair_share`, the weight its agents broadcast at the last count."""
     for t in range(m):
         i = pairs[begin + t, 0]
         j = pairs[begin + t, 1]
-        share = pair_share(i, j, weight)
+        share = pair_share(i, j, weight) if mean else 1.0
         for a in range(n_axes):
             u[i, a] += chunks[w, a, t] * share
             u[j, a] -= chunks[w, a, t] * share

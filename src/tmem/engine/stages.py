@@ -157,7 +157,7 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def corrected_positions(known, agents, law, run, neighbours, gas, listed, observe, counting):
+def corrected_positions(known, agents, law, run, neighbours, gas, listed, counting):
     """``P* = x . K / K_P`` (6) of every agent as it knows itself, and its true ``P``, into
     ``agents.corrected``; clear the set-points (and, at a count of the gas, its counts:
     :func:`tmem.engine.gas.clear`).
@@ -175,14 +175,12 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
     listed : int
         What the lists hold: 0, ``P*`` (the exact path), or 1, ``P`` (the sensed path, whose range
         is one of positions).
-    observe : bool
-        ``Gas.observe``, a constant of the compiled loop (:data:`tmem.engine.loop.OBSERVED`).
     counting : bool
-        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).
+        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`): never when
+        the gas is not observed.
     """
     box = run.box
     work = gas.work
-    c_max = gas.c_max
     n_axes = len(box)
     use_lists = run.use_lists
     gains = law.gains
@@ -211,8 +209,8 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, observ
                 if use_lists:
                     delta = nearest_image((star if listed == 0 else position) - p_ref[i, a], box[a])
                     shift2 += delta * delta
-            if observe:
-                clear(i, known, work, n_axes, counting)
+            if counting:
+                clear(i, known, work, n_axes)
             if active[i]:
                 largest = max(largest, shift2)
         block_shift2[b] = largest

@@ -45,13 +45,6 @@ COMMON_FLOOR = 0.25
 FULL_CONTACT = 0.1
 
 
-@numba.njit(cache=True, inline="always")
-def _common(i, a, known, work, per_contact):
-    """Along axis ``a``, the velocity of agent ``i``'s group (T3): half its own, half the mean of its
-    neighbours' weighted by their contacts (``per_contact``: one over their sum)."""
-    return 0.5 * (known[i, a, 1] + work[i, NEIGHBOUR_VELOCITY + a] * per_contact)
-
-
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
     """At a count, agent ``i``'s push on its group (T3), kept until the next count.
@@ -86,13 +79,14 @@ def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
     per_contact = 1.0 / contact if contact > 0.0 else 0.0
     group2 = 0.5 * (work[i, SPEED2] + work[i, NEIGHBOUR_SPEED2] * per_contact)
     common2 = 0.0
-    for a in range(n_axes):
-        common2 += _common(i, a, known, work, per_contact) ** 2
+    for a in range(n_axes):  # the common velocity first, scaled to the push below
+        held[i, COMMON + a] = 0.5 * (known[i, a, 1] + work[i, NEIGHBOUR_VELOCITY + a] * per_contact)
+        common2 += held[i, COMMON + a] ** 2
     floor2 = max(common2, COMMON_FLOOR * group2)
     push = together * rate * (target2 - group2) * inv_g / floor2 if floor2 > 0.0 else 0.0
     held[i, TOGETHER] = together
     for a in range(n_axes):
-        held[i, COMMON + a] = push * _common(i, a, known, work, per_contact)
+        held[i, COMMON + a] *= push
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
