@@ -44,7 +44,7 @@ def _swarms(seconds: float) -> dict[str, tmem.Scenario]:
 def _update_times(scenario: tmem.Scenario, rounds: int = 2000) -> tuple[float, float]:
     """Median seconds of one message and of one update of agent 0, all messages of the swarm given."""
     controllers = controllers_for(scenario)
-    states = tmem.initial.build(scenario).state
+    states = tmem.world.initial.build(scenario).state
     made, updated = [], []
     for k in range(rounds):
         t = k * scenario.simulation.dt

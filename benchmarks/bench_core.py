@@ -21,7 +21,7 @@ define them):
   every 10th recorded), steps/s, the median of 20 runs after one warm-up;
 * ``encounters``: examples/sweeps/encounters.toml's first 2000 random starts
   under both functions (4000 of its 20 000 cases), drawn as ``tmem sweep``
-  draws them, cases/s of ``tmem.batch.run_batch`` (no Dask);
+  draws them, cases/s of ``tmem.batch.encounters.run_batch`` (no Dask);
 * ``paper-cold``, ``paper-warm``: ``tmem paper`` end to end; cold runs a
   copy of the side's ``src`` without ``__pycache__`` with a new, empty
   ``NUMBA_CACHE_DIR`` (compilation included), warm the side's own tree
@@ -100,7 +100,7 @@ def child_encounters() -> float:
     """Cases per second of ``run_batch`` on the study's first :data:`ENCOUNTER_DRAWS` starts, both functions."""
     import numpy as np
     from pin_results import sweep_cases
-    from tmem.batch import run_batch
+    from tmem.batch.encounters import run_batch
     from tmem.scenario import with_changes
 
     base, points = sweep_cases(STUDY)

@@ -1,9 +1,9 @@
 """How long ``tmem export`` takes, and how large its files are, for a run directory.
 
 Times, in one interpreter after the libraries are loaded: reading the run back
-(:func:`tmem.exchange.recording.read_recording`), writing the MCAP file
-(:func:`tmem.exchange.foxglove.write_mcap`) and the CSV files
-(:func:`tmem.exchange.crazyswarm.write_csv_files`); the median of ``--repeat``
+(:func:`tmem.files.exchange.recording.read_recording`), writing the MCAP file
+(:func:`tmem.files.exchange.foxglove.write_mcap`) and the CSV files
+(:func:`tmem.files.exchange.crazyswarm.write_csv_files`); the median of ``--repeat``
 rounds.  Printed with the sizes of ``trajectory.nc``, the MCAP file and the CSV
 files, the records and agents, and the machine's load average (the machine is
 shared: a busy one slows every figure).
@@ -46,10 +46,10 @@ def main() -> None:
     args = parser.parse_args()
 
     import tmem
-    from tmem.exchange.crazyswarm import write_csv_files
-    from tmem.exchange.foxglove import write_mcap
-    from tmem.exchange.recording import read_recording
-    from tmem.io import write_netcdf
+    from tmem.files.exchange.crazyswarm import write_csv_files
+    from tmem.files.exchange.foxglove import write_mcap
+    from tmem.files.exchange.recording import read_recording
+    from tmem.files.io import write_netcdf
 
     with tempfile.TemporaryDirectory() as work:
         work = Path(work)

@@ -29,9 +29,9 @@ import time
 from pathlib import Path
 
 import tmem
-from tmem.io import write_run
+from tmem.files.io import write_run
 from tmem.scenario import load, with_changes
-from tmem.viewer import write_view
+from tmem.figures.viewer import write_view
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"

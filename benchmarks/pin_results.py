@@ -12,7 +12,7 @@ missing on either side, or an array differs by more than ``--rtol``
 
 Only the API likely to outlive a refactor is used: ``tmem.preset``,
 ``tmem.load`` / ``tmem.loads``, ``tmem.scenario.with_changes``,
-``tmem.simulate``, ``tmem.metrics.summarize`` and ``tmem.batch.run_batch``.
+``tmem.simulate``, ``tmem.analysis.metrics.summarize`` and ``tmem.batch.encounters.run_batch``.
 A run's pinned arrays are the trajectory's ``time``, ``state``, ``control``,
 ``active``, ``flag``, ``pair_distance``, ``interaction_distance``,
 ``min_distance``, ``min_neighbor_distance``, ``final_state`` and
@@ -125,7 +125,7 @@ def numeric_fields(node, path: str) -> dict[str, np.ndarray]:
 def run_arrays(scenario) -> dict[str, np.ndarray]:
     """Simulate ``scenario``; the trajectory's pinned arrays, its events and its summary's numbers."""
     import tmem
-    from tmem.metrics import summarize
+    from tmem.analysis.metrics import summarize
 
     trajectory = tmem.simulate(scenario)
     arrays = {name: np.asarray(getattr(trajectory, name)) for name in TRAJECTORY_FIELDS if hasattr(trajectory, name)}
@@ -207,7 +207,7 @@ def sweep_cases(path: Path) -> tuple[object, list[tuple[dict, list[tuple[int, di
 
 def encounter_arrays(path: Path, grid_point: int) -> dict[str, np.ndarray]:
     """One grid point of the encounter study on ``run_batch``: every BatchResult array and the starts."""
-    from tmem.batch import run_batch
+    from tmem.batch.encounters import run_batch
     from tmem.scenario import with_changes
 
     base, points = sweep_cases(path)

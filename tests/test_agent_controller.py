@@ -83,7 +83,7 @@ def _messages(controllers, states, t=0.0, skip=()):
 def _setpoints(scenario, change=None):
     """Every agent's set-point at the start, each controller given the messages ``change`` leaves it."""
     controllers = controllers_for(scenario)
-    states = tmem.initial.build(scenario).state
+    states = tmem.world.initial.build(scenario).state
     messages = _messages(controllers, states)
     return np.array([c.update(x, change(c.agent, messages) if change else messages, 0.0) for c, x in zip(controllers, states)])
 

@@ -9,10 +9,10 @@ import pytest
 import xarray as xr
 from PIL import Image, ImageChops
 
-from tmem.animate import animate
-from tmem.animate.frames import read_frames
-from tmem.animate.scene import positions, scene, update
-from tmem.trajectory_file import FRAME_AXES, OVER_AGENTS, OVER_PAIRS, TIME_UNITS
+from tmem.figures.animate import animate
+from tmem.figures.animate.frames import read_frames
+from tmem.figures.animate.scene import positions, scene, update
+from tmem.files.trajectory_file import FRAME_AXES, OVER_AGENTS, OVER_PAIRS, TIME_UNITS
 
 SCENARIO = 'name = "synthetic"\n\n[interaction]\nradius = 20.0\nd_t = 35.0\n'
 
@@ -20,7 +20,7 @@ SCENARIO = 'name = "synthetic"\n\n[interaction]\nradius = 20.0\nd_t = 35.0\n'
 def _dataset(n_times=30, n_axes=2, agents=(0, 1, 2), pairs=((0, 1),), active=True, d_t=True):
     """Agents on straight lines, the pairs coupling halfway, the last agent removed at two thirds.
 
-    Laid out as ``trajectory.nc`` is (:mod:`tmem.trajectory_file`): per agent over (agent, time),
+    Laid out as ``trajectory.nc`` is (:mod:`tmem.files.trajectory_file`): per agent over (agent, time),
     the positions as the coordinates x, y, z (a 1-D run with y = 0), a variable per axis.
     """
     n = len(agents)
@@ -174,7 +174,7 @@ def test_damaged_trajectory_gives_one_line_and_exit_2_from_the_command(tmp_path)
     path = _write(tmp_path) / "trajectory.nc"
     path.write_bytes(_header_flipped(path.read_bytes()))
     proc = subprocess.run(
-        [sys.executable, "-c", "from tmem.cli import main; main()", "animate", str(tmp_path)],
+        [sys.executable, "-c", "from tmem.cli.main import main; main()", "animate", str(tmp_path)],
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert proc.returncode == 2, proc.stderr

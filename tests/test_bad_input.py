@@ -8,7 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
+from tmem.cli.main import app
 
 GOOD = tmem.preset("fig9").to_toml()
 
@@ -245,7 +245,7 @@ def test_unwritable_output_gives_one_line_and_leaves_nothing(tmp_path, runner, m
     def full(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("tmem.outputs.replace._new_partial_directory", full)
+    monkeypatch.setattr("tmem.files.outputs.replace._new_partial_directory", full)
     out = tmp_path / "new" / "deeper" / "out"
     result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", str(out)])
     assert result.exit_code == 2 and "No space left" in result.stderr
@@ -267,7 +267,7 @@ def test_console_script_exits_2_without_traceback(tmp_path):
     scenario = tmp_path / "bad.toml"
     scenario.write_text(CASES["d_t beyond reach"][0])
     proc = subprocess.run(
-        [sys.executable, "-c", "from tmem.cli import main; main()", "run", str(scenario), "--out", str(tmp_path / "o")],
+        [sys.executable, "-c", "from tmem.cli.main import main; main()", "run", str(scenario), "--out", str(tmp_path / "o")],
         capture_output=True,
         text=True,
     )

@@ -28,7 +28,7 @@ import pytest
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
+from tmem.cli.main import app
 
 FIG9 = tomllib.loads(tmem.preset("fig9").to_toml())
 SWARM = {

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem.batch import run_batch
-from tmem.metrics import summarize
+from tmem.batch.encounters import run_batch
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
 STARTS = [((50.0, 0.0), (-1.5, 3.0)), ((60.0, 0.0), (-2.0, 2.0)), ((0.0, 45.0), (4.0, -4.0)), ((100.0, 0.0), (-0.5, 1.0))]
@@ -43,7 +43,7 @@ def test_batch_equals_the_engine(function, switch_at):
 
 @pytest.mark.parametrize("function", ["switching", "improved"])
 def test_the_two_paths_agree_on_one_axis(function):
-    """Under the window rule, one axis runs on the relative state (tmem.relative_batch); with the energy
+    """Under the window rule, one axis runs on the relative state (tmem.batch.relative); with the energy
     rule or synchronisation it steps both agents.  Each against the engine."""
     base = with_changes(tmem.preset("fig9"), {"interaction.function": function, "simulation.duration": 45.0})
     positions = np.array([p for p, _ in STARTS])

@@ -22,12 +22,12 @@ import pytest
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
+from tmem.cli.main import app
 from tmem.engine import checkpoint as ckpt
 from tmem.engine import records
 from tmem.engine.checkpoint import CheckpointError, Checkpoints, checkpoint_path
 from tmem.engine.gas_columns import COMMON
-from tmem.model.quadrotor import BODY_NAMES
+from tmem.vehicles.quadrotor import BODY_NAMES
 from tmem.scenario import from_dict, with_changes
 
 from test_interruptions import Command, partials  # starts `python -m tmem`, waits for a moment

@@ -11,7 +11,7 @@ import typer
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
+from tmem.cli.main import app
 
 PYPROJECT = Path(__file__).parent.parent / "pyproject.toml"
 #: Words that name what an option's number counts or measures.

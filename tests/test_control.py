@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy.signal import place_poles
 
-from tmem.control import interaction_point, modal_gains, printed_gains, roots
-from tmem.model.linear import state_matrices
+from tmem.law.modal import interaction_point, modal_gains, printed_gains, roots
+from tmem.vehicles.linear import state_matrices
 
 CASES = [
     dict(kp=6.0, kd=25.0, g=9.8, r_l=12.0, im_l=0.1, im_r=0.55),  # Table 1

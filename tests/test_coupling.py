@@ -3,8 +3,8 @@
 import pytest
 
 import tmem
-from tmem.coupling import next_flag
-from tmem.metrics import summarize
+from tmem.law.coupling import next_flag
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
 D_T, EPS = 35.0, 0.2

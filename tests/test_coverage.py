@@ -1,11 +1,11 @@
-"""Coverage of a bounded field (tmem.coverage), checked against closed forms and hand counts."""
+"""Coverage of a bounded field (tmem.analysis.coverage), checked against closed forms and hand counts."""
 
 import math
 
 import numpy as np
 import pytest
 
-from tmem.coverage import MAX_CELLS, Coverage, coverage, plot_coverage
+from tmem.analysis.coverage import MAX_CELLS, Coverage, coverage, plot_coverage
 
 
 def _run(points, times=None, active=None, box=(10.0, 10.0), cell=1.0, **options) -> Coverage:

@@ -103,8 +103,8 @@ def test_the_stored_scenario_lists_the_agents_and_loads_without_the_yaml(tmp_pat
 
 
 def test_the_robots_names_name_the_trajectories(tmp_path):
-    from tmem.io import write_netcdf
-    from tmem.trajectory_file import open_trajectory, positions
+    from tmem.files.io import write_netcdf
+    from tmem.files.trajectory_file import open_trajectory, positions
 
     trajectory = tmem.simulate(tmem.load(_scenario(tmp_path, axes=2)))
     write_netcdf(trajectory, tmp_path / "trajectory.nc")

@@ -6,7 +6,7 @@ from scipy.linalg import expm
 
 import tmem
 from tmem.engine import record_steps
-from tmem.model.linear import state_matrices
+from tmem.vehicles.linear import state_matrices
 from tmem.scenario import with_changes
 
 
@@ -126,7 +126,7 @@ def test_three_agents_on_a_line_interact_pairwise():
 
 def test_each_agent_corrected_position_uses_its_own_gains():
     """The P* stage (6) with a different row of gains per agent matches x . K_i / K_P,i row by row."""
-    from tmem.control import interaction_point
+    from tmem.law.modal import interaction_point
     from tmem.engine.records import Agents, Law, Neighbours, Run
     from tmem.engine.gas import gas_record
     from tmem.engine.stages import corrected_positions

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem.metrics import summarize
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
 EXAMPLES = Path(__file__).parent.parent / "examples"

@@ -15,10 +15,10 @@ from scipy.spatial.transform import Rotation
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
-from tmem.exchange import export
-from tmem.exchange.attitude import attitude_quaternion
-from tmem.io import write_netcdf, write_run
+from tmem.cli.main import app
+from tmem.files.exchange import export
+from tmem.files.exchange.attitude import attitude_quaternion
+from tmem.files.io import write_netcdf, write_run
 from tmem.scenario import with_changes
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
@@ -152,7 +152,7 @@ def test_mcap_positions_times_and_plots_are_the_runs(triangle, tmp_path):
         drawn = [len(line.points) // 2 for line in coupled if line.color.a == 1.0]
         assert sum(drawn) == int(trajectory.flag[r].sum())
     rms = [point.y for _, point in messages["/metrics/rms_velocity"]]
-    np.testing.assert_array_equal(rms, tmem.metrics.rms_velocity(trajectory.state[..., 1], trajectory.active))
+    np.testing.assert_array_equal(rms, tmem.analysis.metrics.rms_velocity(trajectory.state[..., 1], trajectory.active))
     for p, (i, j) in enumerate(trajectory.pairs.tolist()):
         points = messages[f"/pairs/agent{i + 1}-agent{j + 1}/distance"]
         assert [stamp for stamp, _ in points] == stamps
@@ -263,7 +263,7 @@ def test_a_file_export_did_not_write_is_kept(triangle, tmp_path):
 @pytest.mark.parametrize("to, module, writer", [("mcap", "foxglove", "write_mcap"), ("csv", "crazyswarm", "write_csv_files")])
 def test_an_interrupted_export_leaves_nothing(triangle, tmp_path, monkeypatch, to, module, writer):
     """Ctrl-C halfway through writing: neither the output nor a temporary file is left."""
-    target = importlib.import_module(f"tmem.exchange.{module}")
+    target = importlib.import_module(f"tmem.files.exchange.{module}")
     real = getattr(target, writer)
 
     def interrupted(recording, where):

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem.io import write_netcdf
+from tmem.files.io import write_netcdf
 from tmem.scenario import with_changes
-from tmem.trajectory_file import components, open_trajectory, positions, run_axes
+from tmem.files.trajectory_file import components, open_trajectory, positions, run_axes
 
 #: Loading the checker's plugins warns of one (not used here) that is to go.
 pytestmark = pytest.mark.filterwarnings("ignore:The ioos_sos checker is deprecated:DeprecationWarning")

@@ -63,8 +63,8 @@ EXTENSIONS = {
                 def step_params(self, dt):
                     return HoldStep(*zero_order_hold(*self.linearisation(), dt))
             ''')),
-        ("model/__init__.py", '    "linear": "tmem.model.linear:LinearModel",\n',
-         '    "linear": "tmem.model.linear:LinearModel",\n    "drag": "tmem.model.drag:DragModel",\n'),
+        ("model/__init__.py", '    "linear": "tmem.vehicles.linear:LinearModel",\n',
+         '    "linear": "tmem.vehicles.linear:LinearModel",\n    "drag": "tmem.vehicles.drag:DragModel",\n'),
         ("scenario/tables.py", "def _linear_unless_named", textwrap.dedent('''\
             class DragModelParams(StrictModel):
                 """The linear model with drag: ``[model] kind = "drag"``."""
@@ -138,7 +138,7 @@ def test_a_new_interaction_function_is_chosen_by_name_and_run_by_the_loop(extend
                            "simulation": {"dt": 0.01, "duration": 0.1, "record_every": 1}})
             tr = tmem.simulate(s)
             results[n] = [float(tr.control[0, 0, 0]), float(tr.control[0, 1, 0])]
-        results["evaluate"] = tmem.interaction.evaluate("plateau", [-30.0, 30.0, 45.0], k_p=1.0, reach=40.0, d_t=35.0, c_max=0.1).tolist()
+        results["evaluate"] = tmem.law.interaction.evaluate("plateau", [-30.0, 30.0, 45.0], k_p=1.0, reach=40.0, d_t=35.0, c_max=0.1).tolist()
         print(json.dumps(results))
     ''')
     for n in ("2", "80"):
@@ -153,7 +153,7 @@ def test_a_new_vehicle_model_gets_its_gains_placed_and_flies_its_own_dynamics(ex
         import json
         import numpy as np
         import tmem
-        from tmem.model import vehicle_model
+        from tmem.vehicles import vehicle_model
         from tmem.scenario import from_dict
         s = from_dict({"model": {"kind": "drag", "c_d": 0.5}, "interaction": {"function": "repulsion"},
                        "agents": [{"position": 0.0, "velocity": 2.0}, {"position": 5000.0}],

@@ -11,12 +11,12 @@ import xarray as xr
 from matplotlib.collections import LineCollection, PathCollection
 
 import tmem
-from tmem import drawing
-from tmem.io import write_run
-from tmem.plot import figures_of
-from tmem.saved import read_run
+from tmem.figures import drawing
+from tmem.files.io import write_run
+from tmem.figures.plot import figures_of
+from tmem.files.saved import read_run
 from tmem.scenario import load, with_changes
-from tmem.shape_plot import moments
+from tmem.figures.shape_plot import moments
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 SHORT = {"simulation.duration": 3.0, "simulation.record_every": 1000}  # 31 records
@@ -188,8 +188,8 @@ def test_figures_of_a_run_read_back_are_those_drawn_at_its_end(hex19, triangle_3
 
 
 def test_animation_numbers_every_agent_and_fits_its_strain_scale_to_the_run(hex19):
-    from tmem.animate.frames import read_frames
-    from tmem.animate.scene import positions, scene
+    from tmem.figures.animate.frames import read_frames
+    from tmem.figures.animate.scene import positions, scene
 
     _, out, ds = hex19
     frames = read_frames(out, max_frames=400)  # every record

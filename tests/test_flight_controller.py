@@ -1,4 +1,4 @@
-"""The acceleration inner loop (tmem.model.flight_controller): its reference against the closed form of (1),
+"""The acceleration inner loop (tmem.vehicles.flight_controller): its reference against the closed form of (1),
 its linearisation at hover against the paper's (2), the airframe flying (2)'s trajectory, and (slow) Fig. 9 and the hex."""
 
 from __future__ import annotations
@@ -11,12 +11,12 @@ import pytest
 from scipy.linalg import expm
 
 import tmem
-from tmem.metrics import formation_summary, summarize
-from tmem.model.flight_controller import acceleration_loop, advance_reference
-from tmem.model.linear import state_matrices
-from tmem.model.flight_controller import rate_loop
-from tmem.model.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, step_quadrotor
-from tmem.model.rigid_body import derivative, loads
+from tmem.analysis.metrics import formation_summary, summarize
+from tmem.vehicles.flight_controller import acceleration_loop, advance_reference
+from tmem.vehicles.linear import state_matrices
+from tmem.vehicles.flight_controller import rate_loop
+from tmem.vehicles.quadrotor import GUSTS, REFERENCE, QuadrotorModel, axis_view, step_quadrotor
+from tmem.vehicles.rigid_body import derivative, loads
 from tmem.scenario import QuadrotorModelParams, WindParams
 
 CALM = (0.0, 0.0, 0.0)

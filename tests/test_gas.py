@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem.control import interaction_point, modal_gains
+from tmem.law.modal import interaction_point, modal_gains
 from tmem.engine.gas import TOTALS
-from tmem.interaction.kernels import evaluate
-from tmem.model.linear import state_matrices
-from tmem.observables import gas_summary, temperature
+from tmem.law.interaction.kernels import evaluate
+from tmem.vehicles.linear import state_matrices
+from tmem.analysis.observables import gas_summary, temperature
 from tmem.scenario import ScenarioError, from_dict
 
 G, KP, KD = 9.8, 6.0, 25.0
@@ -102,7 +102,7 @@ def _swarm(n, box, periodic=True, **tables):
 
 def _contacts(scenario, states):
     """Each agent's contacts: the squared sizes of its neighbours' pushes (8) over c_max^2, summed."""
-    gains = tmem.control.gains_for(*tmem.model.vehicle_model(scenario.model).linearisation(), 12.0, 0.1, 0.55)
+    gains = tmem.law.modal.gains_for(*tmem.vehicles.vehicle_model(scenario.model).linearisation(), 12.0, 0.1, 0.55)
     p_star = interaction_point(states, gains)
     box = np.asarray(scenario.space.box)
     ia = scenario.interaction
@@ -118,7 +118,7 @@ def _contacts(scenario, states):
 def _brute_pushes(scenario, states, crowd):
     """Every pair's push (8) on the P* (6) of ``states``, weighted 1 / max(1, crowd_i, crowd_j), summed
     and saturated; and each agent's number of neighbours within reach."""
-    gains = tmem.control.gains_for(*tmem.model.vehicle_model(scenario.model).linearisation(), 12.0, 0.1, 0.55)
+    gains = tmem.law.modal.gains_for(*tmem.vehicles.vehicle_model(scenario.model).linearisation(), 12.0, 0.1, 0.55)
     p_star = interaction_point(states, gains)
     box = np.asarray(scenario.space.box)
     ia = scenario.interaction
@@ -259,7 +259,7 @@ def test_both_agents_of_a_pair_get_the_same_thermostat_push():
     zero: the thermostat heats the pair's common motion, and only that."""
     tr = _pair(3.0, angle=40.0, thermostat={"rms_velocity": 3.6, "tau": 1.0})
     scenario = from_dict({"name": "gains", "agents": [{"position": 0.0}, {"position": 100.0}]})
-    gains = tmem.control.gains_for(*tmem.model.vehicle_model(scenario.model).linearisation(), 12.0, 0.1, 0.55)
+    gains = tmem.law.modal.gains_for(*tmem.vehicles.vehicle_model(scenario.model).linearisation(), 12.0, 0.1, 0.55)
     ia = scenario.interaction
     rest = []
     saturated = []
@@ -546,10 +546,10 @@ def test_a_field_run_writes_the_gas_and_coverage(tmp_path):
 
     from typer.testing import CliRunner
 
-    from tmem.cli import app
-    from tmem.coverage import coverage
-    from tmem.trajectory_file import open_trajectory
-    from tmem.trajectory_file import positions as recorded_positions
+    from tmem.cli.main import app
+    from tmem.analysis.coverage import coverage
+    from tmem.files.trajectory_file import open_trajectory
+    from tmem.files.trajectory_file import positions as recorded_positions
 
     base = Path(__file__).parent.parent / "examples" / "swarm" / "field.toml"
     scenario = tmem.scenario.with_changes(tmem.load(base), {"swarm.n": 12, "simulation.duration": 60.0})
@@ -602,7 +602,7 @@ def test_threads_give_the_serial_bits(monkeypatch):
 
 def test_a_two_agent_sweep_with_walls_is_not_batched():
     """Walls, obstacles and the gas's options belong to the step loop: the batch refuses them."""
-    from tmem.batch import unsupported
+    from tmem.batch.encounters import unsupported
 
     for change in ({"space.walls": True, "space.box": [1000.0]}, {"interaction.combine": "mean"},
                    {"obstacles": [{"center": [-500.0], "radius": 400.0}]}):  # fmt: skip

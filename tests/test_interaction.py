@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tmem import interaction
+from tmem.law import interaction
 
 K_P, REACH, D_T, C_MAX = 0.0296347, 40.0, 35.0, 0.1
 PARAMS = dict(k_p=K_P, reach=REACH, d_t=D_T, c_max=C_MAX)
@@ -139,7 +139,7 @@ def test_continuity_is_as_the_registry_claims(row):
 
 @pytest.mark.parametrize("row", ROWS)
 def test_each_row_names_a_kernel_and_its_code_dispatches_to_it(row):
-    from tmem.interaction import kernels
+    from tmem.law.interaction import kernels
 
     code = interaction.code(row.name)
     params = kernels.FunctionParams(K_P, REACH, D_T, C_MAX)

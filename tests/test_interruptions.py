@@ -28,7 +28,7 @@ import pytest
 from dask.distributed import Client, LocalCluster
 from typer.testing import CliRunner
 
-from tmem.cli import app
+from tmem.cli.main import app
 from tmem.sweep import loads_sweep, run_sweep
 
 ROOT = Path(__file__).parent.parent
@@ -203,7 +203,7 @@ def test_a_signal_after_the_command_is_done_keeps_its_exit_status():
     for signum in (signal.SIGINT, signal.SIGTERM):
         script = (
             "import os, sys\n"
-            "from tmem.cli import main\n"
+            "from tmem.cli.main import main\n"
             "sys.argv = ['tmem', '--help']\n"
             f"try:\n    main()\nfinally:\n    os.kill(os.getpid(), {int(signum)})\n"
         )

@@ -37,12 +37,12 @@ def test_loading_a_file_and_editing_it_loads_no_numba():
 
 
 def test_the_command_line_module_loads_nothing_heavy():
-    assert loaded_after("import tmem.cli") == set()
+    assert loaded_after("import tmem.cli.main") == set()
 
 
 @pytest.mark.parametrize("args", [["--help"], ["--version"], ["run", "--help"], ["sweep", "--help"], ["plot", "--help"], ["export", "--help"]])
 def test_help_works_and_loads_nothing_heavy(args):
-    code = f"import sys; sys.argv = ['tmem', *{args!r}]\nfrom tmem.cli import main\ntry:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code"
+    code = f"import sys; sys.argv = ['tmem', *{args!r}]\nfrom tmem.cli.main import main\ntry:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code"
     assert loaded_after(code) == set()
 
 
@@ -80,3 +80,17 @@ def test_numba_cache_is_dropped_when_any_source_below_the_package_changes(tmp_pa
     (package / "sub" / "b.py").write_text("y = 2\n")  # a subpackage's source changed
     _numba_cache.refresh()
     assert not any(c.exists() for c in caches)
+
+
+def test_a_module_moved_by_role_still_imports_under_its_old_name(monkeypatch):
+    import importlib
+
+    for name in ("tmem.model", "tmem.model.linear"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    with pytest.warns(DeprecationWarning, match=r"tmem\.model\.linear is now tmem\.vehicles\.linear"):
+        old = importlib.import_module("tmem.model.linear")
+    from tmem.vehicles.linear import state_matrices
+
+    assert old.state_matrices is state_matrices
+    with pytest.raises(AttributeError):
+        old.nonsense  # noqa: B018

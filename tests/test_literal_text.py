@@ -7,7 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
+from tmem.cli.main import app
 
 #: fig9 shortened to 2 s at dt = 1 ms, the command moved to 1 s: a run of a moment.
 SHORT = (

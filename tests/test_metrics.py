@@ -5,9 +5,9 @@ import pytest
 
 import tmem
 from tmem.engine import Event, Trajectory
-from tmem.metrics import nearest_distance, pair_summary, rms_velocity, summarize
-from tmem.initial import build
-from tmem.model import vehicle_model
+from tmem.analysis.metrics import nearest_distance, pair_summary, rms_velocity, summarize
+from tmem.world.initial import build
+from tmem.vehicles import vehicle_model
 
 
 def made(distance, flag, events, velocities=None):
@@ -141,7 +141,7 @@ def test_every_agent_gone_gives_null_not_inf_or_nan():
 def test_table_marks_an_rms_change_taken_while_coupled():
     from rich.console import Console
 
-    from tmem.terminal import SWINGS, summary_table
+    from tmem.cli.terminal import SWINGS, summary_table
 
     rows = {}
     for name, (distance, flag, events, start, _) in COUPLING.items():
@@ -184,8 +184,8 @@ def test_the_table2_pair_left_coupled_is_flagged_in_summary_and_table(tmp_path):
 
     from typer.testing import CliRunner
 
-    from tmem.cli import app
-    from tmem.terminal import SWINGS
+    from tmem.cli.main import app
+    from tmem.cli.terminal import SWINGS
 
     text = tmem.preset("fig9").to_toml().split("[[commands]]")[0]
     text = text.replace("duration = 60.0", "duration = 6.0").replace("dt = 0.0001", "dt = 0.001")

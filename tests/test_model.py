@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.signal import cont2discrete
 
-from tmem.model.linear import state_matrices, zero_order_hold
+from tmem.vehicles.linear import state_matrices, zero_order_hold
 
 
 def test_matrices_are_those_of_equation_2():

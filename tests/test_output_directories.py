@@ -1,4 +1,4 @@
-"""Output directories (tmem.outputs): which may be replaced, what is refused, leftovers, the sweep's lock."""
+"""Output directories (tmem.files.outputs): which may be replaced, what is refused, leftovers, the sweep's lock."""
 
 import json
 import os
@@ -14,8 +14,8 @@ import pytest
 from dask.distributed import LocalCluster
 from typer.testing import CliRunner
 
-from tmem.cli import app
-from tmem.outputs import MANIFEST, OutputError, lock, partial_name
+from tmem.cli.main import app
+from tmem.files.outputs import MANIFEST, OutputError, lock, partial_name
 from tmem.sweep import loads_sweep, run_sweep
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
@@ -263,7 +263,7 @@ def test_a_sweep_interrupted_while_making_its_directory_leaves_nothing(tmp_path,
 HOLD_LOCK = """
 import sys, time
 from pathlib import Path
-from tmem.outputs import lock
+from tmem.files.outputs import lock
 with lock(Path(sys.argv[1]), "sweep"):
     print("held", flush=True)
     time.sleep(60)

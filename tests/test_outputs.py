@@ -9,9 +9,9 @@ import xarray as xr
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
-from tmem.metrics import rms_velocity
-from tmem.trajectory_file import components, open_trajectory, positions
+from tmem.cli.main import app
+from tmem.analysis.metrics import rms_velocity
+from tmem.files.trajectory_file import components, open_trajectory, positions
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 REQUIRED = {
@@ -81,7 +81,7 @@ def test_dataset_matches_summary_and_carries_units_and_scenario(fig9_run):
 @pytest.mark.parametrize("scenario", ["fig9.toml", "swarm/ring8_loss.toml"])
 def test_trajectory_file_reads_back_as_xarray_writes_it(scenario, tmp_path):
     """tmem writes trajectory.nc through h5netcdf directly; read back, it is what xarray's own writer gives."""
-    from tmem.io import to_dataset, write_netcdf
+    from tmem.files.io import to_dataset, write_netcdf
 
     trajectory = tmem.simulate(tmem.load(EXAMPLES / scenario))
     to_dataset(trajectory).to_netcdf(tmp_path / "by_xarray.nc", engine="h5netcdf")

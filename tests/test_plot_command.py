@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-import tmem.plot
-from tmem.cli import app
-from tmem.outputs import MANIFEST
+import tmem.figures.plot
+from tmem.cli.main import app
+from tmem.files.outputs import MANIFEST
 
 FIGURES = ["distance.png", "paths.png", "shape.png", "velocity.png"]  # two agents in the plane, no formation
 
@@ -150,18 +150,18 @@ def test_out_holding_something_else_is_refused(run_dir, tmp_path):
 @pytest.mark.parametrize("into_out", [False, True], ids=["in place", "--out"])
 def test_interrupted_while_drawing_leaves_everything_as_it_was(run_dir, tmp_path, monkeypatch, into_out):
     """Ctrl-C after some figures are drawn: none of them replaces anything, no temporary folder stays."""
-    draw = tmem.plot.write_figures
+    draw = tmem.figures.plot.write_figures
 
     def interrupted(trajectory, directory):
         draw(trajectory, directory)
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(tmem.plot, "write_figures", interrupted)
+    monkeypatch.setattr(tmem.figures.plot, "write_figures", interrupted)
     (run_dir / "velocity.png").write_bytes(b"old")
     before = snapshot(run_dir)
     out = tmp_path / "figures" if into_out else None
     with pytest.raises(KeyboardInterrupt):
-        tmem.plot.redraw(run_dir, out)
+        tmem.figures.plot.redraw(run_dir, out)
     assert snapshot(run_dir) == before
     assert not (tmp_path / "figures").exists()
     assert [p.name for p in tmp_path.iterdir()] == ["run"]

@@ -1,4 +1,4 @@
-"""The quadrotor model (tmem.model.quadrotor) against RotorPy, its linearisation against (2), and its symmetries.
+"""The quadrotor model (tmem.vehicles.quadrotor) against RotorPy, its linearisation against (2), and its symmetries.
 
 RotorPy (``rotorpy.vehicles.multirotor.Multirotor``, MIT) integrates the same
 Crazyflie with scipy's adaptive Runge-Kutta from its own equations; it is fed
@@ -15,10 +15,10 @@ import math
 import numpy as np
 import pytest
 
-from tmem.model.flight_controller import acceleration_loop, advance_reference, initial_reference, rate_loop, tilt_loop
-from tmem.model.quadrotor import GUSTS, QuadrotorModel, axis_view, step_quadrotor
-from tmem.model.rigid_body import derivative, hover_speed, loads
-from tmem.model.linear import state_matrices
+from tmem.vehicles.flight_controller import acceleration_loop, advance_reference, initial_reference, rate_loop, tilt_loop
+from tmem.vehicles.quadrotor import GUSTS, QuadrotorModel, axis_view, step_quadrotor
+from tmem.vehicles.rigid_body import derivative, hover_speed, loads
+from tmem.vehicles.linear import state_matrices
 from tmem.scenario import QuadrotorModelParams
 
 #: The inner period of the comparison with RotorPy (s): one sub-step per step.

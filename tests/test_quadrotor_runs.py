@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem.io import contents
-from tmem.model.quadrotor import ACCELERATION_BODY_NAMES, BODY_NAMES
+from tmem.files.io import contents
+from tmem.vehicles.quadrotor import ACCELERATION_BODY_NAMES, BODY_NAMES
 from tmem.scenario import from_dict
 
 
@@ -75,7 +75,7 @@ def test_an_agent_added_back_starts_again_with_its_body():
 
 
 def test_the_continuous_reference_refuses_the_quadrotor_in_one_line():
-    from tmem.reference import integrate
+    from tmem.analysis.reference import integrate
 
     with pytest.raises(ValueError, match=r"^model\.kind: .*body state") as refused:
         integrate(from_dict({"model": {"kind": "quadrotor"}, "interaction": {"function": "repulsion"},

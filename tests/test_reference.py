@@ -1,4 +1,4 @@
-"""The engine against the continuous-time reference (:mod:`tmem.reference`).
+"""The engine against the continuous-time reference (:mod:`tmem.analysis.reference`).
 
 The engine's only error is sampling the control (zero-order hold of (2)), so
 it must approach the continuous solution as ``dt`` shrinks, at first order.
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import tmem
-from tmem.reference import final_state, integrate
+from tmem.analysis.reference import final_state, integrate
 from tmem.scenario import Scenario, from_dict, with_changes
 
 DTS = (1e-2, 1e-3, 1e-4, 1e-5)

@@ -14,8 +14,8 @@ import pytest
 from scipy import stats
 
 import tmem
-from tmem.control import interaction_point
-from tmem.interaction import evaluate
+from tmem.law.modal import interaction_point
+from tmem.law.interaction import evaluate
 from tmem.scenario import with_changes
 
 #: Bounds of the statistical checks: a two-sided level of 1e-6 (about 4.9 standard deviations).
@@ -60,7 +60,7 @@ def held_message(tr: tmem.Trajectory) -> np.ndarray:
 def test_the_hash_is_splitmix64():
     """The compiled hash against a pure-Python SplitMix64 (Vigna's splitmix64.c): its first output
     from state 0 is the published 0xE220A8397B1DCDAF, and a draw is the chain over its five numbers."""
-    from tmem.streams import message_key, mix, uniform
+    from tmem.world.streams import message_key, mix, uniform
 
     mask = 2**64 - 1
 
@@ -86,7 +86,7 @@ def test_normal_draws_are_standard_normal_and_independent():
     """100 000 pairs of draws over steps and senders: each draw's mean, variance (chi-square) and
     Kolmogorov-Smirnov test against the normal law, and no correlation within a pair, between
     pairs of one message, or between neighbouring steps."""
-    from tmem.streams import message_key, normal_pair
+    from tmem.world.streams import message_key, normal_pair
 
     n = 100_000
     keys = [np.uint64(message_key(5, 2, 1 + k % 7, k)) for k in range(n)]

@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 import tmem
-from tmem.cli import app
+from tmem.cli.main import app
 from tmem.engine import driver
 from tmem.scenario import from_dict, with_changes
 
@@ -144,7 +144,7 @@ def test_what_the_sensed_path_cannot_do_is_refused_in_one_line():
         tmem.simulate(gas, sensing={})
     with pytest.raises(ValueError, match="^sensing.range: is required"):
         tmem.simulate(swarm("verlet", None), sensing={})
-    from tmem.batch import run_batch
+    from tmem.batch.encounters import run_batch
 
     noisy = with_changes(tmem.preset("fig7"), {"sensing": {"position_noise": 0.1}})
     with pytest.raises(ValueError, match="^run_batch: the agents measure each other exactly"):

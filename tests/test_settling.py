@@ -11,10 +11,10 @@ import pytest
 from scipy.signal import place_poles
 
 import tmem
-from tmem.interaction import evaluate
-from tmem.metrics import SETTLE_BAND, summarize
+from tmem.law.interaction import evaluate
+from tmem.analysis.metrics import SETTLE_BAND, summarize
 from tmem.scenario import with_changes
-from tmem.synchronise import synchronising_gain
+from tmem.law.synchronise import synchronising_gain
 
 G, KP, KD = 9.8, 6.0, 25.0
 

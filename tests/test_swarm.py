@@ -6,8 +6,8 @@ import pytest
 import tmem
 from tmem.engine import driver as engine
 from tmem.engine.driver import _partners
-from tmem.metrics import summarize
-from tmem.neighbors import arrange, verlet_pairs
+from tmem.analysis.metrics import summarize
+from tmem.world.neighbors import arrange, verlet_pairs
 from tmem.scenario import from_dict, with_changes
 
 
@@ -282,7 +282,7 @@ def test_a_pair_feels_its_function_whatever_the_size_of_the_swarm(function, n_ag
     })  # fmt: skip
     tr = tmem.simulate(scenario)
     k_p = tr.gains[0]
-    expected = tmem.interaction.evaluate(function, 30.0, 0, k_p=k_p, reach=40.0, d_t=35.0, c_max=1.0)
+    expected = tmem.law.interaction.evaluate(function, 30.0, 0, k_p=k_p, reach=40.0, d_t=35.0, c_max=1.0)
     assert tr.control[0, 0, 0] == pytest.approx(float(expected), rel=1e-12)
     assert tr.control[0, 1, 0] == pytest.approx(-float(expected), rel=1e-12)
     if function == "attraction":

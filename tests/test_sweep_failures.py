@@ -15,7 +15,7 @@ import pytest
 from dask.distributed import LocalCluster
 from typer.testing import CliRunner
 
-from tmem.cli import app
+from tmem.cli.main import app
 from tmem.sweep import SweepError, loads_sweep, run_sweep
 from tmem.sweep.cluster import DaskLog, check_workers, dask_client
 from tmem.sweep.store import ResultStore

@@ -14,7 +14,7 @@ import pytest
 from dask.distributed import Client, LocalCluster
 
 import tmem
-from tmem.metrics import summarize
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 from tmem.sweep import SweepInterrupted, loads_sweep, run_sweep
 from tmem.sweep.report import coupling_statistics, rms_statistics

@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 from typer.testing import CliRunner
 
-from tmem.cli import app
+from tmem.cli.main import app
 
 SCENARIO = 'name = "old"\n[space]\naxes = 2\n[interaction]\nradius = 20.0\n'
 

@@ -13,7 +13,7 @@ import pytest
 from dask.distributed import LocalCluster
 
 import tmem
-from tmem.metrics import LAST_WINDOW, SETTLE_BAND, summarize
+from tmem.analysis.metrics import LAST_WINDOW, SETTLE_BAND, summarize
 from tmem.scenario import ScenarioError, load, with_changes
 from tmem.sweep import SweepError, load_sweep, loads_sweep, run_sweep
 

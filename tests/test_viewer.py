@@ -18,14 +18,14 @@ import pytest
 import xarray as xr
 from typer.testing import CliRunner
 
-from tmem.cli import app
-from tmem.model.linear import LinearModel
-from tmem.viewer import default_out, write_view
-from tmem.drawing import STRAIN_FLOOR
-from tmem.trajectory_file import RunReadError
-from tmem.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, agent_status, read_view, strain_scale
-from tmem.viewer import data
-from tmem.viewer.page import VIEW_MARK, headline, quantised
+from tmem.cli.main import app
+from tmem.vehicles.linear import LinearModel
+from tmem.figures.viewer import default_out, write_view
+from tmem.figures.drawing import STRAIN_FLOOR
+from tmem.files.trajectory_file import RunReadError
+from tmem.figures.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FRAMES, REMOVED, WAITING, agent_status, read_view, strain_scale
+from tmem.figures.viewer import data
+from tmem.figures.viewer.page import VIEW_MARK, headline, quantised
 
 VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
 
@@ -216,7 +216,7 @@ def test_what_is_not_a_run_is_refused_in_one_line_and_nothing_is_written(runner,
 
 def test_view_help_loads_nothing_heavy():
     probe = (
-        "import sys; sys.argv = ['tmem', 'view', '--help']\nfrom tmem.cli import main\n"
+        "import sys; sys.argv = ['tmem', 'view', '--help']\nfrom tmem.cli.main import main\n"
         "try:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code\n"
         "print('loaded:', *(m for m in ('numba', 'xarray', 'matplotlib', 'h5netcdf') if m in sys.modules))"
     )

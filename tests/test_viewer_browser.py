@@ -23,10 +23,10 @@ import xarray as xr
 from PIL import Image
 
 import tmem
-from tmem.io import write_run
+from tmem.files.io import write_run
 from tmem.scenario import load
-from tmem.viewer import write_view
-from tmem.viewer.data import read_view
+from tmem.figures.viewer import write_view
+from tmem.figures.viewer.data import read_view
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = Path(os.environ.get("TMEM_CHROMIUM", "/usr/bin/chromium"))

@@ -1,4 +1,4 @@
-"""Wind on the quadrotor (tmem.model.wind): each part against an independent reference.
+"""Wind on the quadrotor (tmem.vehicles.wind): each part against an independent reference.
 
 * the constant wind: the compiled vehicle against RotorPy's own integration in its ``ConstantWind``,
   and a closed form: without the drag feed-forward an agent alone (``U = 0``: the TMEM law pushes
@@ -23,9 +23,9 @@ from typer.testing import CliRunner
 import tmem
 from test_bad_input import GOOD, quadrotor as on_the_quadrotor
 from test_quadrotor import MANOEUVRES, PERIOD, fly_rotorpy, fly_tmem
-from tmem.cli import app
-from tmem.model.quadrotor import BODY_NAMES, GUSTS, REFERENCE, QuadrotorModel, step_quadrotor
-from tmem.model.wind import (
+from tmem.cli.main import app
+from tmem.vehicles.quadrotor import BODY_NAMES, GUSTS, REFERENCE, QuadrotorModel, step_quadrotor
+from tmem.vehicles.wind import (
     FOOT,
     SEVERITY_W20,
     dryden_psd,

@@ -6,7 +6,7 @@ Run from the repository root::
 
 For repulsion (8) and attraction (Fig. 3), the engine (exact zero-order hold
 of (2), control sampled every ``dt``) is compared with the continuous-time
-reference of :mod:`tmem.reference`.  For switching (10) and improved
+reference of :mod:`tmem.analysis.reference`.  For switching (10) and improved
 switching (11) there is no reference (the coupling flag changes at sampled
 instants), so the smallest ``dt`` stands for the converged value.
 """
@@ -16,10 +16,10 @@ from __future__ import annotations
 import numpy as np
 
 import tmem
-from tmem.metrics import rms_velocity
-from tmem.reference import final_state
+from tmem.analysis.metrics import rms_velocity
+from tmem.analysis.reference import final_state
 from tmem.scenario import Scenario, with_changes
-from tmem.initial import build
+from tmem.world.initial import build
 
 DTS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 

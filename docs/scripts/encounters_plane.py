@@ -20,8 +20,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from tmem.coupling import RELEASES  # noqa: E402
-from tmem.paper import COMMAND_TIME  # noqa: E402
+from tmem.law.coupling import RELEASES  # noqa: E402
+from tmem.paper.report import COMMAND_TIME  # noqa: E402
 
 VARIANTS = {  # (uncouple_when, synchronise) -> label
     ("window", False): "window (9)",
@@ -145,7 +145,7 @@ to 5 m/s within 30° of +x; agent 0 at 45 to 80 m, beyond R + R_j = 40 m, at a b
 flying at 1 to 5 m/s within 30° of −x (each uniform). So the pairs meet head-on, at angles, and off
 centre; {s_w['wide']:.1f} % of them pass wide and never come within reach. Failed runs: {failed}.
 
-Reproduce (the sweep runs the batch of `tmem.batch`, the step loop's own pair stage with free
+Reproduce (the sweep runs the batch of `tmem.batch.encounters`, the step loop's own pair stage with free
 flight skipped in closed form):
 
     tmem sweep examples/sweeps/encounters_plane.toml --out out/encounters_plane

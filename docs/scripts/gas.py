@@ -26,9 +26,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tmem  # noqa: E402
-from tmem.control import modal_gains  # noqa: E402
-from tmem.model.linear import state_matrices  # noqa: E402
-from tmem.observables import gas_summary, temperature  # noqa: E402
+from tmem.law.modal import modal_gains  # noqa: E402
+from tmem.vehicles.linear import state_matrices  # noqa: E402
+from tmem.analysis.observables import gas_summary, temperature  # noqa: E402
 from tmem.scenario import from_dict, with_changes  # noqa: E402
 
 OUT = Path(__file__).resolve().parent.parent / "gas"
@@ -293,8 +293,8 @@ def equation_of_state() -> None:
 
 def field() -> None:
     """The coverage map of examples/swarm/field.toml (figure) and its coverage summary."""
-    from tmem.coverage import coverage_summary
-    from tmem.plot import field_figure
+    from tmem.analysis.coverage import coverage_summary
+    from tmem.figures.plot import field_figure
 
     tr = tmem.simulate(tmem.load(EXAMPLES / "field.toml"))
     field_figure(tr).savefig(OUT / "field.png", dpi=110)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 import tmem
-from tmem.metrics import rms_velocity
+from tmem.analysis.metrics import rms_velocity
 from tmem.scenario import with_changes
 
 TIMES = (0, 2, 5, 10, 20, 40, 60, 90, 120)

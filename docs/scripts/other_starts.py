@@ -10,7 +10,7 @@ functions are run, and the script prints ``docs/other_starts.md`` in full::
 from __future__ import annotations
 
 import tmem
-from tmem.metrics import summarize
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
 #: (velocity of agent 0 at 50 m, velocity of agent 1 at 0 m), m/s.

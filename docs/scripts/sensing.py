@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 import tmem
-from tmem.metrics import summarize
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
 SEEDS = range(1, 6)

@@ -18,7 +18,7 @@ import sys
 import time
 
 import tmem
-from tmem.metrics import summarize
+from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
 #: The values swept, one parameter at a time; the others keep the preset's value.
@@ -120,7 +120,7 @@ def main() -> None:
         "everything else is fixed at the presets' values: Table 1 model and controller, Table 2 initial "
         f"conditions, R = R_j = {base.interaction.radius:g} m, `dt` = {sim.dt:g} s, duration {sim.duration:g} s, "
         f"recording every {sim.record_every} steps, and the uncouple command at t = {COMMAND_TIME:g} s. "
-        "\"RMS change %\" is `rms_change_percent` of `tmem.metrics.summarize` (final over initial RMS velocity, "
+        "\"RMS change %\" is `rms_change_percent` of `tmem.analysis.metrics.summarize` (final over initial RMS velocity, "
         "minus one); \"uncouple t\" is when the pair's flag F_en returns to 0 after the command; "
         "\"separated t\" is the first recorded time after that at which the distance reaches R + R_j "
         "(`pairs[0][\"separated_at\"]`); \"—\" means the event never happened in the run. "

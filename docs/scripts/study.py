@@ -6,7 +6,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-from tmem.paper import PAPER  # noqa: E402
+from tmem.paper.report import PAPER  # noqa: E402
 
 DOCS = Path(__file__).resolve().parents[1]
 FIGURES = DOCS / "encounters"

@@ -27,7 +27,7 @@ matplotlib.use("Agg")  # files only
 import matplotlib.pyplot as plt  # noqa: E402
 
 import tmem  # noqa: E402
-from tmem.metrics import summarize  # noqa: E402
+from tmem.analysis.metrics import summarize  # noqa: E402
 from tmem.scenario import Scenario, from_dict, load, with_changes  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent.parent

@@ -24,9 +24,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 import test_quadrotor as manoeuvres  # noqa: E402
 
 import tmem  # noqa: E402
-from tmem.control import gains_for  # noqa: E402
-from tmem.metrics import formation_summary, summarize  # noqa: E402
-from tmem.model.quadrotor import BODY_NAMES, QuadrotorModel  # noqa: E402
+from tmem.law.modal import gains_for  # noqa: E402
+from tmem.analysis.metrics import formation_summary, summarize  # noqa: E402
+from tmem.vehicles.quadrotor import BODY_NAMES, QuadrotorModel  # noqa: E402
 from tmem.scenario import QuadrotorModelParams, from_dict, load  # noqa: E402
 
 

@@ -21,9 +21,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 import test_quadrotor as manoeuvres  # noqa: E402
 
 import tmem  # noqa: E402
-from tmem.metrics import formation_summary, summarize  # noqa: E402
-from tmem.model.quadrotor import BODY_NAMES, QuadrotorModel, step_quadrotor  # noqa: E402
-from tmem.model.wind import SEVERITY_W20  # noqa: E402
+from tmem.analysis.metrics import formation_summary, summarize  # noqa: E402
+from tmem.vehicles.quadrotor import BODY_NAMES, QuadrotorModel, step_quadrotor  # noqa: E402
+from tmem.vehicles.wind import SEVERITY_W20  # noqa: E402
 from tmem.scenario import QuadrotorModelParams, WindParams, from_dict, load  # noqa: E402
 
 #: The constant wind of the comparison with RotorPy (m/s, world frame).

@@ -31,7 +31,7 @@ import numpy as np
 
 import tmem
 from tmem.agent import AgentController, AgentMessage, controllers_for
-from tmem.model import vehicle_model
+from tmem.vehicles import vehicle_model
 from tmem.scenario import with_changes
 
 HERE = Path(__file__).resolve().parent
@@ -92,7 +92,7 @@ def fly_nodes(scenario: tmem.Scenario) -> list[SimulatedVehicle]:
     dt = scenario.simulation.dt
     model = vehicle_model(scenario.model)
     topic = Topic()
-    starts = tmem.initial.build(scenario).state
+    starts = tmem.world.initial.build(scenario).state
     vehicles = [SimulatedVehicle(model, start, dt) for start in starts]
     nodes = [AgentNode(c, v, topic) for c, v in zip(controllers_for(scenario), vehicles)]
     for k in range(scenario.simulation.n_steps + 1):

@@ -1,5 +1,5 @@
 """``python -m tmem``: the same as the ``tmem`` command."""
 
-from .cli import main
+from tmem.cli.main import main
 
 main()

@@ -28,9 +28,9 @@ paper's equations and the conditions of the bit-identity.
 
 from __future__ import annotations
 
-from .controller import AgentController
-from .messages import AgentMessage
-from .settings import ControllerError, Edge, OperatorCommand
-from .swarm import Flight, controllers_for, fly
+from tmem.agent.controller import AgentController
+from tmem.agent.messages import AgentMessage
+from tmem.agent.settings import ControllerError, Edge, OperatorCommand
+from tmem.agent.swarm import Flight, controllers_for, fly
 
 __all__ = ["AgentController", "AgentMessage", "ControllerError", "Edge", "Flight", "OperatorCommand", "controllers_for", "fly"]

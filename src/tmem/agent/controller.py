@@ -28,15 +28,15 @@ from numbers import Real
 
 import numpy as np
 
-from ..engine.driver import read_events
-from ..engine.law import law_record
-from ..engine.records import COMMANDS, Events
-from ..engine.stages import command_pair
-from ..engine.trajectory import Event
-from ..interaction.kernels import FunctionParams
-from .kernel import PAIR_FLOATS, PAIR_INTS, control, events_from, law_tables, message_vectors, pairs_from
-from .messages import AgentMessage
-from .settings import DEFAULTS, ControllerError, ControllerSettings, Edge, OperatorCommand
+from tmem.engine.driver import read_events
+from tmem.law.record import law_record
+from tmem.engine.records import COMMANDS, Events
+from tmem.engine.stages import command_pair
+from tmem.engine.trajectory import Event
+from tmem.law.interaction.kernels import FunctionParams
+from tmem.agent.kernel import PAIR_FLOATS, PAIR_INTS, control, events_from, law_tables, message_vectors, pairs_from
+from tmem.agent.messages import AgentMessage
+from tmem.agent.settings import DEFAULTS, ControllerError, ControllerSettings, Edge, OperatorCommand
 
 #: Where the number of events logged in an update is kept (:class:`tmem.engine.records.Counters`).
 _N_EVENTS = 3
@@ -51,7 +51,7 @@ class AgentController:
         This agent's id, as the others' messages name it.
     gains : array_like, shape (4,)
         ``K = (K_P, K_V, K_phi, K_omega)`` placing the roots (5) for the vehicle
-        (:func:`tmem.control.gains_for`, :func:`tmem.control.modal_gains`).
+        (:func:`tmem.law.modal.gains_for`, :func:`tmem.law.modal.modal_gains`).
     dt : float
         The update period (s): ``update`` at time ``t`` runs the tick ``round(t / dt)``; commands
         and the energy rule's fallback are counted in ticks.
@@ -70,15 +70,15 @@ class AgentController:
     eps : float
         The coupling window of (9) (m).
     switch_at : str
-        ``"window"`` or ``"crossing"``: where the flag flips (:mod:`tmem.coupling`).
+        ``"window"`` or ``"crossing"``: where the flag flips (:mod:`tmem.law.coupling`).
     uncouple_when : str
-        ``"window"`` (9) or ``"energy"`` (the paper's energy match, :mod:`tmem.coupling`).
+        ``"window"`` (9) or ``"energy"`` (the paper's energy match, :mod:`tmem.law.coupling`).
     energy_tolerance : float
         The energy rule's relative tolerance.
     fallback_time : float or None
         With the energy rule, how long after an uncouple command (9) takes over (s).
     sync_gain : float
-        ``k_s`` of the speed synchronisation (S2) (rad per m/s; :func:`tmem.synchronise.synchronising_gain`);
+        ``k_s`` of the speed synchronisation (S2) (rad per m/s; :func:`tmem.law.synchronise.synchronising_gain`);
         0: none.
     edges : sequence of Edge
         The formation edges: neighbour, ``d_t``, the direction to hold, ``F_en`` at the start.

@@ -7,14 +7,14 @@ formation edge, and its edges are formation pairs ``(i, j)`` with ``i`` the
 lower id, the orientation the engine gives them.  :func:`control` runs, for
 that one agent, what the step loop runs for every agent:
 
-1. ``P*`` (6) of the agent (:func:`tmem.control.corrected_position`);
+1. ``P*`` (6) of the agent (:func:`tmem.law.modal.corrected_position`);
 2. the pushes of the other neighbours, (8) or the scenario's function, each
-   ``f(|d|) d / |d|`` (:func:`tmem.interaction.kernels.push_factor`), added in
+   ``f(|d|) d / |d|`` (:func:`tmem.law.interaction.kernels.push_factor`), added in
    the order given;
 3. each formation pair heard from: its flag ``F_en`` ((9), or the energy
    rule), its pull or push (10)/(11), its synchronisation (S2), by the
    engine's own :func:`tmem.engine.pairs.formation_pair`;
-4. the sum saturated on its norm, ``|U| <= c_max`` (:func:`tmem.control.tilt_scale`).
+4. the sum saturated on its norm, ``|U| <= c_max`` (:func:`tmem.law.modal.tilt_scale`).
 
 The sums run in the engine's order: the neighbours' pushes first, in the
 order of the engine's numbering of the agents, then the formation pairs by
@@ -34,14 +34,14 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..control import corrected_position, tilt_scale
-from ..engine.pairs import formation_pair
-from ..engine.records import Agents, Counters, Events, Law, Pairs
-from ..interaction.kernels import FunctionParams, push_factor
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.law.modal import corrected_position, tilt_scale
+from tmem.engine.pairs import formation_pair
+from tmem.engine.records import Agents, Counters, Events, Law, Pairs
+from tmem.law.interaction.kernels import FunctionParams, push_factor
 
 #: The integer and the real numbers of the law (:class:`tmem.engine.records.Law` and
-#: :class:`tmem.interaction.kernels.FunctionParams`), in their rows of :func:`law_tables`.
+#: :class:`tmem.law.interaction.kernels.FunctionParams`), in their rows of :func:`law_tables`.
 LAW_INTS = ("function", "neighbour_function", "couples", "at_crossing", "uncouple_rule", "fallback_steps")
 LAW_FLOATS = ("eps", "energy_tolerance", "sync_gain", "k_p", "reach", "d_t", "c_max")
 #: The rows of the edges' tables: the integer and the real columns of :class:`tmem.engine.records.Pairs`.
@@ -67,7 +67,7 @@ def law_tables(law: Law, params: FunctionParams) -> tuple[np.ndarray, np.ndarray
 
 @numba.njit(cache=True, inline="always")
 def law_from(gains, ints, floats):
-    """The :class:`~tmem.engine.records.Law` and :class:`~tmem.interaction.kernels.FunctionParams`
+    """The :class:`~tmem.engine.records.Law` and :class:`~tmem.law.interaction.kernels.FunctionParams`
     held in the arrays of :func:`law_tables`.
 
     Parameters

@@ -9,8 +9,8 @@ a neighbour:
   ``d = P*_j - P*_i`` of the pushes (8), (10), (11) and of the flag ``F_en`` (9).
   The sender computes it with its own gains, as the engine does;
 * its position ``P`` and velocity ``V``, per axis: the pair's distance, its
-  relative kinetic energy (the energy rule of :mod:`tmem.coupling`) and the
-  speed synchronisation (S2) (:mod:`tmem.synchronise`);
+  relative kinetic energy (the energy rule of :mod:`tmem.law.coupling`) and the
+  speed synchronisation (S2) (:mod:`tmem.law.synchronise`);
 * whether it flies: a pair whose agent no longer flies uncouples (the event
   names the rule ``"lost"``), and a grounded agent pushes nobody.
 
@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .settings import ControllerError
+from tmem.agent.settings import ControllerError
 
 #: The numbers before the per-axis vectors on the wire: sender, stamp, flying.
 HEADER = 3

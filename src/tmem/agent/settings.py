@@ -15,9 +15,9 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from ..interaction.registry import FUNCTION_NAMES
-from ..scenario.files import describe
-from ..scenario.tables import FieldError, InteractionParams, NonNegative, Number, Pair, Positive, StrictModel
+from tmem.law.interaction.registry import FUNCTION_NAMES
+from tmem.scenario.files import describe
+from tmem.scenario.tables import FieldError, InteractionParams, NonNegative, Number, Pair, Positive, StrictModel
 
 #: The scenario's ``[interaction]`` defaults, which the controller's are.
 DEFAULTS = InteractionParams()
@@ -113,7 +113,7 @@ class ControllerSettings(_Checked):
     reach, c_max, d_t, eps : float
         ``R + R_j`` (m), the tilt limit (rad), the set distance (m), the coupling window (9) (m).
     switch_at, uncouple_when : str
-        Where the flag flips, and the uncoupling rule (:mod:`tmem.coupling`).
+        Where the flag flips, and the uncoupling rule (:mod:`tmem.law.coupling`).
     energy_tolerance : float
         The energy rule's relative tolerance.
     fallback_time : float or None

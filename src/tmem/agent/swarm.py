@@ -23,15 +23,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..control import gains_for
-from ..engine.driver import record_steps, slot_order
-from ..engine.law import law_of
-from ..engine.trajectory import Event
-from ..initial import build
-from ..model import vehicle_model
-from ..scenario import Scenario
-from .controller import AgentController
-from .settings import ControllerError, Edge, OperatorCommand
+from tmem.law.modal import gains_for
+from tmem.engine.driver import record_steps, slot_order
+from tmem.law.record import law_of
+from tmem.engine.trajectory import Event
+from tmem.world.initial import build
+from tmem.vehicles import vehicle_model
+from tmem.scenario import Scenario
+from tmem.agent.controller import AgentController
+from tmem.agent.settings import ControllerError, Edge, OperatorCommand
 
 #: Most agents :func:`controllers_for` builds: every controller reads every agent's message, so a
 #: step of the loop reads n^2 of them (the engine, with its neighbour lists, is for larger swarms).
@@ -72,8 +72,8 @@ def _refusal(scenario: Scenario) -> tuple[str, str] | None:
 def controllers_for(scenario: Scenario) -> list[AgentController]:
     """One controller per agent of ``scenario``, in the order of its agents.
 
-    Each has the scenario's gains (:func:`tmem.control.gains_for` on the vehicle model) and law
-    (:func:`tmem.engine.law.law_of`), its agent's formation edges, the scenario's couple and
+    Each has the scenario's gains (:func:`tmem.law.modal.gains_for` on the vehicle model) and law
+    (:func:`tmem.law.record.law_of`), its agent's formation edges, the scenario's couple and
     uncouple commands that name one of them (or every pair), and the engine's order of the
     neighbours' pushes (:func:`tmem.engine.driver.slot_order`).
 

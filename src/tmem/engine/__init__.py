@@ -19,8 +19,8 @@ the compiled loop runs it (:mod:`tmem.engine.loop`)::
 
 from __future__ import annotations
 
-from .checkpoint import CheckpointError, Checkpoints
-from .driver import record_steps, simulate
-from .trajectory import DIVERGED, Event, SimulationError, Trajectory
+from tmem.engine.checkpoint import CheckpointError, Checkpoints
+from tmem.engine.driver import record_steps, simulate
+from tmem.engine.trajectory import DIVERGED, Event, SimulationError, Trajectory
 
 __all__ = ["DIVERGED", "CheckpointError", "Checkpoints", "Event", "SimulationError", "Trajectory", "record_steps", "simulate"]

@@ -20,7 +20,7 @@ fields, so a field added to a record later is saved without a change here.
 
 A scenario's random streams (a ``[swarm]``'s starts, a formation's jitter) are drawn from their
 seeds before the first step, and drawn again identically when a run resumes.  The measurement
-stage's noise, delays and losses are counter-based draws (:mod:`tmem.streams`), a function of the
+stage's noise, delays and losses are counter-based draws (:mod:`tmem.world.streams`), a function of the
 seed, the agent and the step alone: there is no generator state to save.
 
 A checkpoint is used only by the run that made it (:func:`fingerprint`): the same scenario as tmem
@@ -43,12 +43,12 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from .. import __version__
-from ..interaction.kernels import FunctionParams
-from ..outputs import write_atomically
-from ..scenario import Scenario
-from ..sensing import Sensing
-from .records import Agents, Commands, Counters, Events, Gas, Law, Neighbours, Pairs, Records, Run
+from tmem import __version__
+from tmem.law.interaction.kernels import FunctionParams
+from tmem.files.outputs import write_atomically
+from tmem.scenario import Scenario
+from tmem.world.sensing import Sensing
+from tmem.engine.records import Agents, Commands, Counters, Events, Gas, Law, Neighbours, Pairs, Records, Run
 
 #: The records that change during a run, under the names a checkpoint gives their fields.
 CHANGING = {
@@ -132,7 +132,7 @@ def checkpoint_path(out: str | Path) -> Path:
     """Where the checkpoints of a run into ``out`` are kept: beside it, hidden, ``.NAME.tmem-checkpoint.npz``.
 
     Outside the output directory, so that it is never taken for output, and not a temporary name
-    of :mod:`tmem.outputs`, so that no command removes it as a leftover.  The name keeps the first
+    of :mod:`tmem.files.outputs`, so that no command removes it as a leftover.  The name keeps the first
     180 bytes of ``out``'s, as temporary names do.
 
     Parameters

@@ -1,7 +1,7 @@
 """The driver of a run: the records built, the compiled loop driven in chunks, the trajectory read back.
 
 :func:`simulate` builds the records of :mod:`tmem.engine.records` from a
-scenario, lists the neighbouring pairs (:mod:`tmem.neighbors`), and runs the
+scenario, lists the neighbouring pairs (:mod:`tmem.world.neighbors`), and runs the
 compiled loop (:mod:`tmem.engine.loop`) in chunks that last about
 ``chunk_seconds``, so that a caller can show progress between them.  When the
 loop reports that the lists are stale (an agent's ``P*`` moved half the skin,
@@ -21,29 +21,29 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..control import gains_for, interaction_point
-from ..initial import InitialArrays, build
-from ..model import vehicle_model
-from ..neighbors import all_pairs, arrange, spatial_order, verlet_pairs
-from ..scenario import Scenario
-from ..scenario.sensing_table import SensingParams
-from ..sensing import exact, sensing_of
-from .checkpoint import Checkpoints, Saved, restore
-from .loop import advance_for
-from .pushes import CHUNK
-from .gas import SNAPSHOT, TOTALS, gas_record
-from .law import law_of
-from .records import (
+from tmem.law.modal import gains_for, interaction_point
+from tmem.world.initial import InitialArrays, build
+from tmem.vehicles import vehicle_model
+from tmem.world.neighbors import all_pairs, arrange, spatial_order, verlet_pairs
+from tmem.scenario import Scenario
+from tmem.scenario.sensing_table import SensingParams
+from tmem.world.sensing import exact, sensing_of
+from tmem.engine.checkpoint import Checkpoints, Saved, restore
+from tmem.engine.loop import advance_for
+from tmem.engine.pushes import CHUNK
+from tmem.engine.gas import SNAPSHOT, TOTALS, gas_record
+from tmem.law.record import law_of
+from tmem.engine.records import (
     COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
-from .trajectory import DIVERGED, SimulationError, Trajectory, read_events
-from .walls import wall_params
+from tmem.engine.trajectory import DIVERGED, SimulationError, Trajectory, read_events
+from tmem.world.walls import wall_params
 
 #: Swarms at least this large step on threads: below, starting the threads at every step costs more
 #: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal
 #: at 10^4).
 THREADED_SWARM = 10_000
-#: Agents per block of the neighbour sums (:func:`tmem.neighbors.arrange`); it fixes the order of
+#: Agents per block of the neighbour sums (:func:`tmem.world.neighbors.arrange`); it fixes the order of
 #: each agent's sum, so results do not depend on the number of threads.
 BLOCK = 4096
 
@@ -171,7 +171,7 @@ class _Slots:
 def slot_order(scenario: Scenario, initial: InitialArrays, gains: np.ndarray) -> np.ndarray:
     """The agent in each slot of a run: a spatial order of the starting ``P*`` (6).
 
-    Each agent adds its neighbours' pushes in this order (:func:`tmem.neighbors.arrange`).
+    Each agent adds its neighbours' pushes in this order (:func:`tmem.world.neighbors.arrange`).
 
     Parameters
     ----------
@@ -237,7 +237,7 @@ def simulate(
     record
         ``False`` records nothing but the end state (for benchmarks).
     sensing
-        Fields of the measurement stage's record (:class:`tmem.sensing.Sensing`) set over the ones of
+        Fields of the measurement stage's record (:class:`tmem.world.sensing.Sensing`) set over the ones of
         the scenario's ``[sensing]`` table, for effects the table does not name; given, even empty,
         the run takes the sensed path.  By default the table decides: without effects, every agent
         knows every state exactly.
@@ -306,7 +306,7 @@ def _read_back(scenario: Scenario, initial: InitialArrays, model, gains: np.ndar
 
 
 def _lists_and_measurement(scenario: Scenario, run: Run, swarm: _Slots, gains: np.ndarray, overrides: dict | None):
-    """The neighbour lister and the measurement stage (:class:`tmem.sensing.Sensing`), and whether the
+    """The neighbour lister and the measurement stage (:class:`tmem.world.sensing.Sensing`), and whether the
     run takes the sensed path.  The exact path lists ``P*`` (6) within ``R + R_j`` and the skin; the
     sensed path the positions within the sensing range and the skin."""
     x = swarm.agents.state

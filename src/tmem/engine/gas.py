@@ -15,7 +15,7 @@ The derivations are in ``docs/gas.md``; equation labels below refer to it.
   pushes.  With one neighbour nothing changes.
 * **Thermostat (T1), (T3)**: :mod:`tmem.engine.thermostat`.
 * **Walls and obstacles (W1)-(W2)** are neighbours held still, with the last word on the
-  set-point: :mod:`tmem.engine.walls`.
+  set-point: :mod:`tmem.world.walls`.
 
 The counts a pair adds to its agents (contacts, the thermostat's groups, the virial, encounters)
 are taken every ``simulation.gas_period`` (a *count*, ``Gas.every`` steps apart), and what they set
@@ -29,13 +29,13 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..scenario import ThermostatParams
-from ..space import nearest_image
-from .gas_columns import COMMON, CONTACT, NEAR, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL
-from .records import Gas
-from .thermostat import add_thermostat_push, hold_group_push
-from .walls import keep_off, wall_pushes, with_priority
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.scenario import ThermostatParams
+from tmem.world.space import nearest_image
+from tmem.engine.gas_columns import COMMON, CONTACT, NEAR, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL
+from tmem.engine.records import Gas
+from tmem.engine.thermostat import add_thermostat_push, hold_group_push
+from tmem.world.walls import keep_off, wall_pushes, with_priority
 
 #: Long name and units of each column of a record, per unit agent mass: first the running totals
 #: of every agent since the start (:data:`TOTALS`), then what a record adds (:data:`SNAPSHOT`).
@@ -219,7 +219,7 @@ def gas_pushes(known, agents, gas, wall_params, run, n_blocks, counting):
         The states as measured.
     agents, gas, run
         The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.
-    wall_params : tmem.interaction.kernels.FunctionParams
+    wall_params : tmem.law.interaction.kernels.FunctionParams
         The repulsion's parameters with ``R + R_w`` for its reach.
     n_blocks : int
         Blocks of agents the parallel loop shares out (those of :func:`tmem.engine.stages.corrected_positions`).
@@ -253,7 +253,7 @@ def _gas_block(begin, end, known, agents, gas, wall_params, box, counting, first
 
 @numba.njit(cache=True, inline="always")
 def tilt_limit(observe, limit, i, c_max):
-    """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`tmem.engine.walls.with_priority`).
+    """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`tmem.world.walls.with_priority`).
 
     Parameters
     ----------
@@ -283,7 +283,7 @@ def tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sa
     i : int
         The agent's slot.
     scale : float
-        The saturation factor of its set-point this step (:func:`tmem.control.tilt_scale`).
+        The saturation factor of its set-point this step (:func:`tmem.law.modal.tilt_scale`).
     work, totals, walls, obstacles : ndarray
         ``Gas.work``, ``Gas.totals`` (changed in place), ``Gas.walls``, ``Gas.obstacles``.
     box : tuple of float

@@ -26,16 +26,16 @@ from functools import cache
 import numba
 import numpy as np
 
-from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..space import into_box
-from ..sensing import measure
-from .records import DONE, LISTS_STALE
-from ..control import tilt_scale
-from .gas import gas_pushes, tally, tilt_limit
-from .pairs import formation_pairs
-from .sensed import sensed_formation_pairs, sensed_neighbour_pushes
-from .pushes import neighbour_pushes
-from .stages import apply_commands, commands_due, corrected_positions, is_recorded, record
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.world.space import into_box
+from tmem.world.sensing import measure
+from tmem.engine.records import DONE, LISTS_STALE
+from tmem.law.modal import tilt_scale
+from tmem.engine.gas import gas_pushes, tally, tilt_limit
+from tmem.engine.pairs import formation_pairs
+from tmem.engine.sensed import sensed_formation_pairs, sensed_neighbour_pushes
+from tmem.engine.pushes import neighbour_pushes
+from tmem.engine.stages import apply_commands, commands_due, corrected_positions, is_recorded, record
 
 #: Whether the loop takes the sensed path (:mod:`tmem.engine.sensed`); bound for each compiled copy by
 #: :func:`advance_for`.  Numba prunes the branch not taken before it types the loop, so the exact
@@ -53,7 +53,7 @@ def vehicle_step(x, body, u, i, scale, params, n_axes):
     Parameters
     ----------
     x, body, u, i, scale, params, n_axes
-        As :attr:`tmem.model.base.VehicleModel.step` takes them.
+        As :attr:`tmem.vehicles.base.VehicleModel.step` takes them.
     """
     raise NotImplementedError("the step loop is compiled by advance_for, which binds the vehicle model's step")
 
@@ -120,7 +120,7 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
 
 @cache
 def advance_for(model_class, threaded: bool, sensed: bool = False, observed: bool = False):
-    """The compiled loop of a vehicle model (a :class:`tmem.model.base.VehicleModel` subclass).
+    """The compiled loop of a vehicle model (a :class:`tmem.vehicles.base.VehicleModel` subclass).
 
     Parameters
     ----------

@@ -1,9 +1,9 @@
 """The formation pairs' stage: each pair's flag ``F_en`` (9), its pull or push (10)/(11), its synchronisation.
 
-A pair couples and uncouples by :mod:`tmem.coupling`: at the window (9), and,
+A pair couples and uncouples by :mod:`tmem.law.coupling`: at the window (9), and,
 with ``interaction.uncouple_when = "energy"``, uncouples where its relative
 kinetic energy and ``f1 - f2`` match their values at coupling.  While coupled
-it may also synchronise its agents' speeds (:mod:`tmem.synchronise`, (S2)).
+it may also synchronise its agents' speeds (:mod:`tmem.law.synchronise`, (S2)).
 """
 
 from __future__ import annotations
@@ -11,12 +11,12 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import coupling
-from ..interaction.kernels import FunctionParams, pair_control
-from ..space import nearest_image
-from ..synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
-from .gas import add_contact, pair_share, virial_by_pairs
-from .stages import log_event
+from tmem.law import coupling
+from tmem.law.interaction.kernels import FunctionParams, pair_control
+from tmem.world.space import nearest_image
+from tmem.law.synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
+from tmem.engine.gas import add_contact, pair_share, virial_by_pairs
+from tmem.engine.stages import log_event
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -40,7 +40,7 @@ def _next_flag(k, e, r, energy, pairs, law, params):
 
     Under the energy rule, at coupling the pair records ``f1 - f2`` and its relative kinetic energy
     ``energy`` (a pair that starts coupled records them at its first step); a disarmed, coupled pair lets go
-    by (9), or by the energy match with its fallback on (9) (:mod:`tmem.coupling`).
+    by (9), or by the energy match with its fallback on (9) (:mod:`tmem.law.coupling`).
     """
     flag = pairs.flag[e]
     p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
@@ -99,7 +99,7 @@ def pair_push(e, d, r, pairs, law, params, n_axes):
 def synchronise(e, i, j, r, dist, entering, pushed, known, pairs, law, params, n_axes, u):
     """(S2) on pair ``e``: from its coupling, its relative motion damped and its mean square speed held
     at its value when it came within reach; after it uncouples, the speed alone, until it is out of
-    reach again (:mod:`tmem.synchronise`).
+    reach again (:mod:`tmem.law.synchronise`).
 
     Called, not inlined, and only where a scenario synchronises: inlined in the step loop it made the
     first run's compilation a third longer for every scenario.
@@ -145,10 +145,10 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
     """Formation pair ``e`` at step ``k``: its flag ``F_en`` after this step's check ((9), or the energy
     match), its smallest distance, its pull or push on both agents, and the synchronisation (S2).
     A pair whose agent was removed uncouples and rests.  The step loop calls it for every pair
-    (:func:`formation_pairs`), and :mod:`tmem.batch` for each encounter of a batch.
+    (:func:`formation_pairs`), and :mod:`tmem.batch.encounters` for each encounter of a batch.
 
     Inlined into the loops and the batch; what only the energy rule and the synchronisation need
-    (:func:`tmem.coupling.function_gap`, :func:`synchronise`) is called, so that their copies of the
+    (:func:`tmem.law.coupling.function_gap`, :func:`synchronise`) is called, so that their copies of the
     interaction functions are compiled once.
 
     Parameters
@@ -156,7 +156,7 @@ def formation_pair(k, e, known, agents, pairs, law, params, box, events, counter
     k, e : int
         The step and the pair.
     known : ndarray, shape (agents, axes, n_state)
-        The states as measured (:func:`tmem.sensing.measure`): the pair's velocities.
+        The states as measured (:func:`tmem.world.sensing.measure`): the pair's velocities.
     agents, pairs, law, events, counters
         The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events`` and ``counters`` change in place.
     params : FunctionParams
@@ -282,7 +282,7 @@ def formation_pairs(k, known, agents, pairs, law, params, run, events, counters,
     k : int
         The step.
     known : ndarray, shape (agents, axes, n_state)
-        The states as measured (:func:`tmem.sensing.measure`).
+        The states as measured (:func:`tmem.world.sensing.measure`).
     agents, pairs, law, run, events, counters, gas
         The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events``,
         ``counters`` and ``gas`` change in place.

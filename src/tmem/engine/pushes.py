@@ -1,7 +1,7 @@
 """The neighbour stage: the pushes of every listed non-formation pair, summed in chunks.
 
 Step 4 of the loop (:mod:`tmem.engine.stages` lists them all).  Each pair ``(i, j)`` of the
-neighbour lists (:mod:`tmem.neighbors`) is pushed once, equal and opposite, with the interaction
+neighbour lists (:mod:`tmem.world.neighbors`) is pushed once, equal and opposite, with the interaction
 function of :attr:`tmem.engine.records.Law.neighbour_function` along ``d / |d|``, ``d = P*_j - P*_i``
 (6).  Pairs are gathered into chunks, pushed in vectorised arithmetic (:func:`_chunk_pushes`), then
 added to the set-points, weighted under the mean of pushes (C1).  At a count of the gas, the adding
@@ -13,10 +13,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..interaction.kernels import push_factor
-from ..space import nearest_image
-from .gas import add_contact, pair_share, virial_by_pairs
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.law.interaction.kernels import push_factor
+from tmem.world.space import nearest_image
+from tmem.engine.gas import add_contact, pair_share, virial_by_pairs
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
 CHUNK = 256
@@ -131,7 +131,7 @@ def neighbour_pushes(agents, neighbours, law, params, run, gas, counting):
     agents, neighbours, law, run, gas
         The loop's records (:mod:`tmem.engine.records`); ``agents``, ``neighbours`` and ``gas`` change
         in place.
-    params : tmem.interaction.kernels.FunctionParams
+    params : tmem.law.interaction.kernels.FunctionParams
         The interaction functions' parameters.
     counting : bool
         Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).

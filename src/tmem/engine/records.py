@@ -6,7 +6,7 @@ Numba compiles them into plain loads and stores.  Arrays are changed in
 place; a record itself is rebuilt only when the neighbour lists are.
 
 Agents live in *slots*, numbered in a spatial order so that neighbours are
-close in memory (:func:`tmem.neighbors.spatial_order`); pairs and records
+close in memory (:func:`tmem.world.neighbors.spatial_order`); pairs and records
 name slots.  The engine translates back to the scenario's agent numbers.
 """
 
@@ -39,11 +39,11 @@ class Law(NamedTuple):
     couples : bool
         Whether the function switches on ``F_en``.
     at_crossing : bool
-        ``interaction.switch_at == "crossing"`` (:func:`tmem.coupling.next_flag`).
+        ``interaction.switch_at == "crossing"`` (:func:`tmem.law.coupling.next_flag`).
     eps : float
         The coupling window of (9) (m).
     uncouple_rule : int
-        Code of ``interaction.uncouple_when`` (:data:`tmem.coupling.UNCOUPLE_RULES`).
+        Code of ``interaction.uncouple_when`` (:data:`tmem.law.coupling.UNCOUPLE_RULES`).
     energy_tolerance : float
         The relative tolerance of the energy-matched uncoupling.
     fallback_steps : int
@@ -52,7 +52,7 @@ class Law(NamedTuple):
         ``k_s`` of the speed synchronisation (S2) (rad per m/s); 0: none.
 
     The interaction functions' parameters travel beside it, as their own
-    record (:class:`~tmem.interaction.kernels.FunctionParams`: the law's ``K_P``,
+    record (:class:`~tmem.law.interaction.kernels.FunctionParams`: the law's ``K_P``,
     ``R + R_j``, the scenario's ``d_t`` and ``c_max``): a parallel loop takes a
     record only as an argument of the function it runs in, not as a field.
     """
@@ -103,12 +103,12 @@ class Agents(NamedTuple):
     active : ndarray, shape (agents,), bool
         Flying; a removed agent stops where it is and no longer interacts.
     corrected : ndarray, shape (agents, axes, 2)
-        ``(P*, P)`` on each axis: ``P*`` as the agent knows itself (:mod:`tmem.sensing`; exact
+        ``(P*, P)`` on each axis: ``P*`` as the agent knows itself (:mod:`tmem.world.sensing`; exact
         without sensing effects), ``P`` true.
     setpoint : ndarray, shape (agents, axes)
         The sum of pushes ``U`` of this step, before saturation.
     body : ndarray, shape (agents, n_body)
-        The vehicle model's body state (:attr:`tmem.model.base.VehicleModel.body_names`; no
+        The vehicle model's body state (:attr:`tmem.vehicles.base.VehicleModel.body_names`; no
         columns for the linear model).
     body_start : ndarray, shape (agents, n_body)
         The body state an added agent starts with.
@@ -137,16 +137,16 @@ class Pairs(NamedTuple):
     flag : ndarray, shape (pairs,), int
         ``F_en``.
     armed : ndarray, shape (pairs,), int
-        The operator's intent (:mod:`tmem.coupling`).
+        The operator's intent (:mod:`tmem.law.coupling`).
     r_before : ndarray, shape (pairs,)
         ``|d|`` one step earlier (NaN before the first step).
     min_distance : ndarray, shape (pairs,)
         Smallest ``|P_j - P_i|`` so far.
     coupled_gap, coupled_energy : ndarray, shape (pairs,)
         ``f1 - f2`` and the relative kinetic energy at the pair's last coupling
-        (:mod:`tmem.coupling`; NaN before it).
+        (:mod:`tmem.law.coupling`; NaN before it).
     entry_speed2, kept_speed2 : ndarray, shape (pairs,)
-        Under synchronisation (:mod:`tmem.synchronise`): the pair's mean square speed
+        Under synchronisation (:mod:`tmem.law.synchronise`): the pair's mean square speed
         ``(|V_i|^2 + |V_j|^2) / 2`` when it last came within reach (or at the start), and ``E*``,
         the value (S2) holds from its coupling until it is out of reach again (NaN: none).
     disarmed_at : ndarray, shape (pairs,), int
@@ -173,7 +173,7 @@ class Pairs(NamedTuple):
 
 
 class Neighbours(NamedTuple):
-    """The other neighbouring pairs, in the loop's order (:func:`tmem.neighbors.arrange`).
+    """The other neighbouring pairs, in the loop's order (:func:`tmem.world.neighbors.arrange`).
 
     Attributes
     ----------
@@ -314,7 +314,7 @@ class Gas(NamedTuple):
 
 class Events(NamedTuple):
     """Coupling transitions and commands, as they happen: step, kind, agents (slots; -1: none), action,
-    and the rule that released a pair (:data:`tmem.coupling.RELEASES`; -1: none)."""
+    and the rule that released a pair (:data:`tmem.law.coupling.RELEASES`; -1: none)."""
 
     step: np.ndarray
     kind: np.ndarray

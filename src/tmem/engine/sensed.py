@@ -1,6 +1,6 @@
 """The step loop's sensed path: each agent pushes from what it measures of itself and its neighbours.
 
-With sensing effects (:mod:`tmem.sensing`), what agent ``i`` knows of ``j``
+With sensing effects (:mod:`tmem.world.sensing`), what agent ``i`` knows of ``j``
 differs from what ``k`` knows of ``j``, so a pair's two pushes are no longer
 equal and opposite: each receiver evaluates its own, from ``d = P*_other -
 P*_own``, its neighbour's ``P*`` (6) as it measures it and its own as it
@@ -13,7 +13,7 @@ them, as before.
 * **Neighbours** (8): a pair within the sensing range (true distance of the
   positions ``P``) gives each of its agents the push of the function at the
   ``|d|`` that agent measures, if it holds a message of the other
-  (:func:`tmem.sensing.latest_message`).  Pairs are visited in the loop's
+  (:func:`tmem.world.sensing.latest_message`).  Pairs are visited in the loop's
   order and each agent adds its pushes in that order, so threads and the kind
   of list do not change the bits.
 * **Formation pairs** (9)-(11): the flag ``F_en`` is the pair's; its first
@@ -27,13 +27,13 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..control import corrected_position
-from ..interaction.kernels import pair_control
-from ..sensing import known_axis, known_corrected, latest_message, message_of
-from ..space import nearest_image
-from ..synchronise import synchronising_push
-from .pairs import check_flag, pair_push, released_if_lost, synchronise
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.law.modal import corrected_position
+from tmem.law.interaction.kernels import pair_control
+from tmem.world.sensing import known_axis, known_corrected, latest_message, message_of
+from tmem.world.space import nearest_image
+from tmem.law.synchronise import synchronising_push
+from tmem.engine.pairs import check_flag, pair_push, released_if_lost, synchronise
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -83,7 +83,7 @@ def _sensed_pushes_of(k, state, corrected, pairs, first, stop, box, function, pa
 def sensed_neighbour_pushes(k, agents, neighbours, law, params, run, sensing):
     """Every listed non-formation pair's pushes, each agent's from its own measurement (module text).
 
-    The blocks of :func:`tmem.neighbors.arrange` run on threads, then the pairs between them, as in
+    The blocks of :func:`tmem.world.neighbors.arrange` run on threads, then the pairs between them, as in
     :func:`tmem.engine.pushes.neighbour_pushes`.
 
     Parameters
@@ -95,7 +95,7 @@ def sensed_neighbour_pushes(k, agents, neighbours, law, params, run, sensing):
     params : FunctionParams
         The interaction functions' parameters.
     sensing : Sensing
-        The measurement stage (:mod:`tmem.sensing`).
+        The measurement stage (:mod:`tmem.world.sensing`).
     """
     box = run.box
     function = law.neighbour_function
@@ -168,7 +168,7 @@ def sensed_formation_pair(k, e, agents, pairs, law, params, box, events, counter
     box : tuple of float
         The box sides (0: open axis).
     sensing : Sensing
-        The measurement stage (:mod:`tmem.sensing`).
+        The measurement stage (:mod:`tmem.world.sensing`).
     """
     if released_if_lost(k, e, agents, pairs, events, counters):
         return
@@ -222,7 +222,7 @@ def sensed_formation_pairs(k, agents, pairs, law, params, run, events, counters,
     params : FunctionParams
         The interaction functions' parameters.
     sensing : Sensing
-        The measurement stage (:mod:`tmem.sensing`).
+        The measurement stage (:mod:`tmem.world.sensing`).
     """
     for e in range(pairs.i.shape[0]):
         sensed_formation_pair(k, e, agents, pairs, law, params, run.box, events, counters, sensing)

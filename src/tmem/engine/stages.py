@@ -6,7 +6,7 @@ of :mod:`tmem.engine.records` in place.  Nothing is allocated at a step: the
 work space comes in the records.
 
 1. :func:`apply_commands` — operator commands due at the step (:func:`commands_due`);
-2. measurement (:func:`tmem.sensing.measure`) — the states as each agent knows them (the
+2. measurement (:func:`tmem.world.sensing.measure`) — the states as each agent knows them (the
    sensed path, :mod:`tmem.engine.sensed`, takes the place of steps 4 and 5);
 3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
    lists have drifted;
@@ -15,7 +15,7 @@ work space comes in the records.
    then, when the gas is observed, :func:`tmem.engine.gas.gas_pushes` — walls, obstacles and the
    thermostat (the gas's counts are taken every ``Gas.every`` steps, in steps 3 to 5);
 6. :func:`record` — the recorded step;
-7. combining and saturating the set-point (:func:`tmem.control.tilt_scale`) and the
+7. combining and saturating the set-point (:func:`tmem.law.modal.tilt_scale`) and the
    vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
 
 Steps 5 and 6 of the agents' update share one pass: the factor that saturates
@@ -28,11 +28,12 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import _numba_cache, coupling  # noqa: F401  (_numba_cache: drops stale compiled code first)
-from ..control import corrected_by, gains_of, tilt_scale
-from ..space import nearest_image
-from .gas import clear, record_totals, tilt_limit
-from .records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.law import coupling
+from tmem.law.modal import corrected_by, gains_of, tilt_scale
+from tmem.world.space import nearest_image
+from tmem.engine.gas import clear, record_totals, tilt_limit
+from tmem.engine.records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
 
 @numba.njit(cache=True, inline="always")
 def log_event(events, counters, k, kind, i, j, action, rule):
@@ -45,13 +46,13 @@ def log_event(events, counters, k, kind, i, j, action, rule):
     k : int
         The step.
     kind : int
-        Event kind (:data:`tmem.coupling.EVENT_KINDS`).
+        Event kind (:data:`tmem.law.coupling.EVENT_KINDS`).
     i, j : int
         Slots of the agents, -1 for none.
     action : int
         Command code (:data:`tmem.engine.records.COMMANDS`), -1 for none.
     rule : int
-        What released a pair (:data:`tmem.coupling.RELEASES`), -1 for none.
+        What released a pair (:data:`tmem.law.coupling.RELEASES`), -1 for none.
     """
     n = counters.n_events[0]
     events.step[n] = k
@@ -81,7 +82,7 @@ def commands_due(k, commands, counters):
 @numba.njit(cache=True, inline="always")
 def command_pair(k, e, kind, pairs):
     """A couple or uncouple command to formation pair ``e`` at step ``k``: arm or disarm it
-    (:mod:`tmem.coupling`); an uncouple command also starts the energy rule's fallback time.
+    (:mod:`tmem.law.coupling`); an uncouple command also starts the energy rule's fallback time.
 
     Parameters
     ----------
@@ -106,7 +107,7 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
     Commands are rare: the loop calls this only when :func:`commands_due`, and it is not inlined.
     Inlined, its code slowed every step of a two-agent run by a quarter.
 
-    ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.coupling`); ``remove`` stops an agent
+    ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.law.coupling`); ``remove`` stops an agent
     where it is (a lost vehicle), ``add`` puts it back at its start; ``temperature`` sets the
     thermostat's RMS velocity (:mod:`tmem.engine.gas`).
 
@@ -168,7 +169,7 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, counti
     Parameters
     ----------
     known : ndarray, shape (agents, axes, n_state)
-        Each agent's own state as it measures it (:func:`tmem.sensing.measure`; the true states when
+        Each agent's own state as it measures it (:func:`tmem.world.sensing.measure`; the true states when
         exact).
     agents, law, run, neighbours, gas
         The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.

@@ -30,9 +30,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .. import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from ..control import saturation
-from .gas_columns import COMMON, CONTACT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.law.modal import saturation
+from tmem.engine.gas_columns import COMMON, CONTACT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
 
 #: The common velocity's square counts as at least this share of the group's mean ``|V|^2`` (T3): a
 #: pair meeting head-on has no common motion to heat, and is left as it is, not pushed hard along a

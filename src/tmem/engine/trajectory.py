@@ -6,11 +6,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import coupling
-from ..initial import InitialArrays
-from ..model.base import VehicleModel
-from ..scenario import Scenario
-from .records import COMMANDS, Events
+from tmem.law import coupling
+from tmem.world.initial import InitialArrays
+from tmem.vehicles.base import VehicleModel
+from tmem.scenario import Scenario
+from tmem.engine.records import COMMANDS, Events
 
 
 class SimulationError(ValueError):
@@ -28,7 +28,7 @@ class Event:
     kind: str  # "command" | "couple" | "uncouple"
     agents: tuple[int, ...]
     action: str | None = None  # for commands: "couple" | "uncouple" | "remove" | "add"
-    rule: str | None = None  # for uncouple events: what released the pair (tmem.coupling.RELEASES)
+    rule: str | None = None  # for uncouple events: what released the pair (tmem.law.coupling.RELEASES)
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,7 @@ class Trajectory:
     gas : ndarray, shape (n_records, 7) or (n_records, 0)
         When the gas is observed (:attr:`Scenario.gas_observed`), at each record the swarm's running
         totals :data:`tmem.engine.gas.TOTALS` and then :data:`tmem.engine.gas.SNAPSHOT`
-        (:mod:`tmem.observables` reads them); no columns otherwise.
+        (:mod:`tmem.analysis.observables` reads them); no columns otherwise.
     body : ndarray, shape (n_records, n_recorded, n_body)
         The vehicle model's body state at each recorded time, named by ``model.body_names``
         (no columns for the linear model).

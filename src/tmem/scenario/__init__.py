@@ -20,15 +20,15 @@ message naming the field and the reason.  Defaults are documented in
 * :mod:`~tmem.scenario.files` — reading, writing and editing files; the presets.
 """
 
-from .agents_table import Agent, SwarmParams, Vector
-from .budget import MAX_RECORD_BYTES
-from .commands_table import Command
-from .files import PRESETS, describe, from_dict, load, loads, preset, read_text, with_changes
-from .formation_table import FormationParams
-from .schema import MAX_AGENTS_ALL_PAIRS, TRACK_ALL_PAIRS, Scenario
-from .sensing_table import SensingParams
-from .space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
-from .tables import (
+from tmem.scenario.agents_table import Agent, SwarmParams, Vector
+from tmem.scenario.budget import MAX_RECORD_BYTES
+from tmem.scenario.commands_table import Command
+from tmem.scenario.files import PRESETS, describe, from_dict, load, loads, preset, read_text, with_changes
+from tmem.scenario.formation_table import FormationParams
+from tmem.scenario.schema import MAX_AGENTS_ALL_PAIRS, TRACK_ALL_PAIRS, Scenario
+from tmem.scenario.sensing_table import SensingParams
+from tmem.scenario.space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
+from tmem.scenario.tables import (
     LIMIT,
     MODEL_KINDS,
     ControllerParams,
@@ -46,7 +46,7 @@ from .tables import (
     SimulationParams,
     StrictModel,
 )
-from .wind_table import TurbulenceParams, WindParams
+from tmem.scenario.wind_table import TurbulenceParams, WindParams
 
 __all__ = [
     "LIMIT",

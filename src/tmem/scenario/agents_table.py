@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING, Annotated
 import numpy as np
 from pydantic import Field, field_validator
 
-from .tables import FieldError, NonNegative, Number, Positive, StrictModel, per_axis
+from tmem.scenario.tables import FieldError, NonNegative, Number, Positive, StrictModel, per_axis
 
 if TYPE_CHECKING:
-    from .schema import Scenario
+    from tmem.scenario.schema import Scenario
 
 Vector = Number | list[Number]
 #: What an agent's name may hold: a robot's name, as ROS writes them (it names the agent's trajectory).

@@ -11,10 +11,10 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
-from .tables import FieldError, SimulationParams
+from tmem.scenario.tables import FieldError, SimulationParams
 
 if TYPE_CHECKING:
-    from .schema import Scenario
+    from tmem.scenario.schema import Scenario
 
 #: Most bytes a run may set aside for its records.
 MAX_RECORD_BYTES = 8 * 2**30

@@ -9,11 +9,11 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from pydantic import model_validator
 
-from ..interaction.registry import uses_coupling
-from .tables import FieldError, NonNegative, Pair, Positive, StrictModel
+from tmem.law.interaction.registry import uses_coupling
+from tmem.scenario.tables import FieldError, NonNegative, Pair, Positive, StrictModel
 
 if TYPE_CHECKING:
-    from .schema import Scenario
+    from tmem.scenario.schema import Scenario
 
 
 class Command(StrictModel):

@@ -25,8 +25,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .agents_table import AGENT_NAME
-from .tables import ScenarioError
+from tmem.scenario.agents_table import AGENT_NAME
+from tmem.scenario.tables import ScenarioError
 
 #: The scenario key naming the file.
 KEY = "agents_from"
@@ -99,7 +99,7 @@ def agents_from(path: Path, axes: int) -> list[dict]:
     axes : int
         The scenario's ``space.axes``: each agent keeps that many of its robot's coordinates.
     """
-    from .files import read_text  # the reader of every scenario file; it imports this module
+    from tmem.scenario.files import read_text  # the reader of every scenario file; it imports this module
 
     try:
         text = read_text(path, "crazyflies.yaml", ScenarioError)

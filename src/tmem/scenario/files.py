@@ -19,9 +19,9 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
-from . import crazyflies
-from .schema import Scenario
-from .tables import MODEL_KINDS, FieldError, ScenarioError
+from tmem.scenario import crazyflies
+from tmem.scenario.schema import Scenario
+from tmem.scenario.tables import MODEL_KINDS, FieldError, ScenarioError
 
 #: Largest scenario or sweep file read (bytes): a bigger one is a mistake, not a scenario.
 MAX_FILE_BYTES = 16 * 2**20

@@ -9,11 +9,11 @@ from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from ..interaction.registry import uses_coupling
-from .tables import FieldError, NonNegative, Number, Positive, StrictModel, per_axis
+from tmem.law.interaction.registry import uses_coupling
+from tmem.scenario.tables import FieldError, NonNegative, Number, Positive, StrictModel, per_axis
 
 if TYPE_CHECKING:
-    from .schema import Scenario
+    from tmem.scenario.schema import Scenario
 
 
 class FormationParams(StrictModel):

@@ -20,16 +20,16 @@ import unicodedata
 import numpy as np
 from pydantic import field_validator, model_validator
 
-from ..coverage import MAX_CELLS
-from ..formation import generate
-from ..interaction.registry import uses_coupling
-from .agents_table import Agent, SwarmParams, check_agents
-from .budget import check_memory, check_record_size, memory_limit
-from .commands_table import Command, check_commands
-from .formation_table import FormationParams, check_formation
-from .sensing_table import SensingParams, check_sensing
-from .space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
-from .tables import (
+from tmem.analysis.coverage import MAX_CELLS
+from tmem.world.formation import generate
+from tmem.law.interaction.registry import uses_coupling
+from tmem.scenario.agents_table import Agent, SwarmParams, check_agents
+from tmem.scenario.budget import check_memory, check_record_size, memory_limit
+from tmem.scenario.commands_table import Command, check_commands
+from tmem.scenario.formation_table import FormationParams, check_formation
+from tmem.scenario.sensing_table import SensingParams, check_sensing
+from tmem.scenario.space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
+from tmem.scenario.tables import (
     ControllerParams,
     FieldError,
     InteractionParams,
@@ -40,7 +40,7 @@ from .tables import (
     StrictModel,
     per_axis,
 )
-from .wind_table import WindParams, check_wind
+from tmem.scenario.wind_table import WindParams, check_wind
 
 #: Beyond this many agents, a coupling function needs a [formation]: without one every pair
 #: would be a formation pair, and their number grows as the square of the swarm.
@@ -240,7 +240,7 @@ class Scenario(StrictModel):
                     raise FieldError(f"agents[{k}].position", f"{place.tolist()} lies inside obstacles[{o}]")
 
     def _check_coverage(self) -> None:
-        """A coverage map needs a walled box, and at most :data:`~tmem.coverage.grid.MAX_CELLS` cells."""
+        """A coverage map needs a walled box, and at most :data:`~tmem.analysis.coverage.grid.MAX_CELLS` cells."""
         settings = self.coverage
         if settings is None:
             return
@@ -311,6 +311,6 @@ class Scenario(StrictModel):
 
     def to_toml(self) -> str:
         """The scenario as TOML text, every default written out."""
-        from .files import _to_toml  # the writer lives with the reader
+        from tmem.scenario.files import _to_toml  # the writer lives with the reader
 
         return _to_toml(self.model_dump(mode="json", exclude_none=True))

@@ -1,6 +1,6 @@
 """The ``[sensing]`` table: what the agents measure of each other, and its checks against the scenario.
 
-Each key turns one effect on (:mod:`tmem.sensing` models them, ``docs/sensing.md`` explains
+Each key turns one effect on (:mod:`tmem.world.sensing` models them, ``docs/sensing.md`` explains
 them); every default turns it off, so a table of defaults measures exactly:
 
 * ``position_noise``, ``velocity_noise`` — the standard deviation of the Gaussian noise on a
@@ -13,7 +13,7 @@ them); every default turns it off, so a table of defaults measures exactly:
 * ``loss`` — the probability that a message from one agent to another is lost;
 * ``hold`` — how long (s) past its largest delay a receiver keeps using the last message it got;
 * ``range`` — the sensing range (m): an agent farther away is not measured at all;
-* ``seed`` — the seed of the random streams (:mod:`tmem.streams`).
+* ``seed`` — the seed of the random streams (:mod:`tmem.world.streams`).
 
 The noise keys say what they blur (position, velocity) and whose state (a neighbour's, or with
 ``own_``, the agent's own), in the order an engineer reads a sensor's data sheet.
@@ -26,10 +26,10 @@ from typing import TYPE_CHECKING, Annotated
 
 from pydantic import BeforeValidator, Field
 
-from .tables import LIMIT, FieldError, NonNegative, Positive, StrictModel
+from tmem.scenario.tables import LIMIT, FieldError, NonNegative, Positive, StrictModel
 
 if TYPE_CHECKING:
-    from .schema import Scenario
+    from tmem.scenario.schema import Scenario
 
 #: Bytes of one agent's state on one axis, in a message kept for delay or loss: (P, V, phi, omega).
 MESSAGE_BYTES_PER_AXIS = 32

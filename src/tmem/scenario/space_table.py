@@ -11,7 +11,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .tables import LIMIT, FieldError, NonNegative, Number, Positive, StrictModel, per_axis
+from tmem.scenario.tables import LIMIT, FieldError, NonNegative, Number, Positive, StrictModel, per_axis
 
 
 class SpaceParams(StrictModel):
@@ -46,7 +46,7 @@ class Obstacle(StrictModel):
 
 
 class CoverageParams(StrictModel):
-    """How the coverage of a walled box is measured (:mod:`tmem.coverage`): square cells of side
+    """How the coverage of a walled box is measured (:mod:`tmem.analysis.coverage`): square cells of side
     ``cell`` (m; default ``R``), each visited when an agent passes within ``sensor_radius`` (m) of its
     centre (0: when it passes through the cell)."""
 

@@ -18,8 +18,8 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
-from ..interaction.registry import FUNCTION_NAMES
-from ..model import MODELS
+from tmem.law.interaction.registry import FUNCTION_NAMES
+from tmem.vehicles import MODELS
 
 
 class ScenarioError(ValueError):
@@ -93,7 +93,7 @@ MAX_RATE_LOOP_STEP = 0.25
 
 class QuadrotorModelParams(StrictModel):
     """A nonlinear quadrotor under the paper's inner loop, ``[model] kind = "quadrotor"``
-    (:mod:`tmem.model.quadrotor`).  Defaults: the Crazyflie 2.x as RotorPy gives it
+    (:mod:`tmem.vehicles.quadrotor`).  Defaults: the Crazyflie 2.x as RotorPy gives it
     (``docs/vehicles.md`` names the source of each number)."""
 
     kind: Literal["quadrotor"]
@@ -179,10 +179,10 @@ class InteractionParams(StrictModel):
     ``uncouple_when``: after an uncouple command, a pair lets go at the first
     moment (9) holds (``"window"``), or where its relative kinetic energy and
     ``f1 - f2`` match their values at coupling, within ``energy_tolerance``
-    (``"energy"``, :mod:`tmem.coupling`).  ``synchronise``: a coupled pair
+    (``"energy"``, :mod:`tmem.law.coupling`).  ``synchronise``: a coupled pair
     damps its relative motion (its slow mode's damping ratio
     ``sync_damping``) and puts the energy into its common motion
-    (:mod:`tmem.synchronise`).  ``combine``: an agent's pushes of several
+    (:mod:`tmem.law.synchronise`).  ``combine``: an agent's pushes of several
     neighbours are summed (``"sum"``, the paper's reading) or averaged over
     the neighbours, walls and obstacles within reach (``"mean"``, which keeps
     each agent's loop ``A - B K`` in crowds: :mod:`tmem.engine.gas`).

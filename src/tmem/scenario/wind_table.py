@@ -1,6 +1,6 @@
 """The ``[wind]`` table: a constant wind and Dryden turbulence on the quadrotor, and its checks.
 
-Keys (:mod:`tmem.model.wind` gives the model and its equations, ``docs/vehicles.md`` explains it):
+Keys (:mod:`tmem.vehicles.wind` gives the model and its equations, ``docs/vehicles.md`` explains it):
 
 * ``velocity`` — the constant wind (m/s, world frame), one number per axis of the run;
 * ``vertical`` — its vertical part (m/s, up), 0 by default;
@@ -25,10 +25,10 @@ from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .tables import FieldError, Number, NonNegative, Positive, StrictModel, per_axis
+from tmem.scenario.tables import FieldError, Number, NonNegative, Positive, StrictModel, per_axis
 
 if TYPE_CHECKING:
-    from .schema import Scenario
+    from tmem.scenario.schema import Scenario
 
 #: The low-altitude model's range of heights, 10 to 1000 ft (m).
 LOWEST, HIGHEST = 3.048, 304.8

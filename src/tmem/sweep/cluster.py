@@ -27,8 +27,8 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from .spec import SweepError
-from .tasks import one_line
+from tmem.sweep.spec import SweepError
+from tmem.sweep.tasks import one_line
 
 #: A ``--scheduler`` must answer as a Dask scheduler within this time (s), or the sweep is refused.
 CONNECT_SECONDS = 10.0

@@ -27,9 +27,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from ..coupling import RELEASES  # noqa: E402
-from ..outputs import write_atomically  # noqa: E402
-from .spec import DISTRIBUTIONS, Sweep  # noqa: E402
+from tmem.law.coupling import RELEASES  # noqa: E402
+from tmem.files.outputs import write_atomically  # noqa: E402
+from tmem.sweep.spec import DISTRIBUTIONS, Sweep  # noqa: E402
 
 RMS = "rms_change_percent"
 PERCENTILES = (5, 25, 75, 95)
@@ -162,7 +162,7 @@ def _coupling_section(groups: list[tuple[str, pd.DataFrame]], command_time: floa
 
 
 def _rule_section(groups: list[tuple[str, pd.DataFrame]]) -> list[str]:
-    """What released the pairs that uncoupled, by setting (:data:`tmem.coupling.RELEASES`)."""
+    """What released the pairs that uncoupled, by setting (:data:`tmem.law.coupling.RELEASES`)."""
     rows = []
     for label, group in groups:
         rules = group.loc[group["error"].isna(), "uncouple_rule"].dropna()

@@ -32,11 +32,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from .cluster import check_workers, dask_client, takes_signals
-from .report import write_report
-from .spec import Sweep
-from .store import ResultStore
-from .tasks import one_line, plan_chunks, row, run_chunk
+from tmem.sweep.cluster import check_workers, dask_client, takes_signals
+from tmem.sweep.report import write_report
+from tmem.sweep.spec import Sweep
+from tmem.sweep.store import ResultStore
+from tmem.sweep.tasks import one_line, plan_chunks, row, run_chunk
 
 #: Rows are written to disk at least this often (s) while tasks finish, and whenever this many wait.
 FLUSH_SECONDS = 2.0

@@ -51,7 +51,7 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import Field, ValidationError, model_validator
 
-from ..scenario import (
+from tmem.scenario import (
     PRESETS,
     FieldError,
     Number,
@@ -64,9 +64,9 @@ from ..scenario import (
     read_text,
     with_changes,
 )
-from ..scenario.files import parse_toml
+from tmem.scenario.files import parse_toml
 
-#: Metrics of ``summary.json`` (:func:`tmem.metrics.summarize`) a sweep can keep, with the batch's too.
+#: Metrics of ``summary.json`` (:func:`tmem.analysis.metrics.summarize`) a sweep can keep, with the batch's too.
 SCALAR_METRICS = (
     "rms_velocity_initial",
     "rms_velocity_final",
@@ -94,7 +94,7 @@ _GAS_KEYS = (
 )
 _COVERAGE_KEYS = "share_final|time_to_50|time_to_90"
 #: Nested figures of ``summary.json`` by dotted path: per formation, per pair (by its index), of the
-#: gas (:func:`tmem.observables.gas_summary`) and of the coverage (:func:`~tmem.coverage.runs.coverage_summary`).
+#: gas (:func:`tmem.analysis.observables.gas_summary`) and of the coverage (:func:`~tmem.analysis.coverage.runs.coverage_summary`).
 NESTED_METRIC = re.compile(
     rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})|gas\.({_GAS_KEYS})|coverage\.({_COVERAGE_KEYS})"
 )

@@ -17,13 +17,13 @@ The output directory of ``tmem sweep`` holds:
 Started again on the same directory with the same sweep, a run reads which
 cases are done from these files and runs only the others.  A directory
 holding another sweep's results is refused, not mixed with; one holding
-anything but a sweep's output too (:func:`tmem.outputs.check_directory`).
+anything but a sweep's output too (:func:`tmem.files.outputs.check_directory`).
 
 The directory appears whole: ``sweep.toml``, ``sweep.json``, the manifest
 ``.tmem-output.json`` and ``parts/`` are written into a temporary directory
 that is renamed into place (a directory holding only ``sweep.toml``, as an
 earlier tmem could leave when killed, is taken up again).  While a sweep
-writes, it holds the directory's lock (:func:`tmem.outputs.lock`); it removes
+writes, it holds the directory's lock (:func:`tmem.files.outputs.lock`); it removes
 what killed processes left (temporary parts, a temporary ``results.parquet``)
 when it takes the lock.
 """
@@ -41,8 +41,8 @@ from pathlib import Path
 import pandas as pd
 import pyarrow as pa
 
-from .. import __version__
-from ..outputs import (
+from tmem import __version__
+from tmem.files.outputs import (
     MANIFEST,
     OutputError,
     check_directory,
@@ -52,7 +52,7 @@ from ..outputs import (
     remove_leftovers,
     write_atomically,
 )
-from .spec import METRIC_TYPES, Sweep
+from tmem.sweep.spec import METRIC_TYPES, Sweep
 
 RESULTS = "results.parquet"
 PARTS = "parts"

@@ -4,8 +4,8 @@ A chunk holds cases that differ only in the agents' starting positions and
 velocities (:func:`plan_chunks` groups them so).  If the scenario is the
 paper's two-agent, one-axis case and every kept metric is one the batch
 computes, the whole chunk runs as one vectorised batch
-(:func:`tmem.batch.run_batch`); otherwise each case is simulated on its own
-and summarised (:func:`tmem.metrics.summarize`).  Either way a case that
+(:func:`tmem.batch.encounters.run_batch`); otherwise each case is simulated on its own
+and summarised (:func:`tmem.analysis.metrics.summarize`).  Either way a case that
 fails (a value the scenario refuses, a run that diverges) becomes a row with
 its error and no metrics; it never stops the chunk.
 
@@ -23,11 +23,11 @@ from typing import Any
 
 import numpy as np
 
-from ..batch import run_batch, unsupported
-from ..engine import DIVERGED, simulate
-from ..metrics import summarize
-from ..scenario import Scenario, ScenarioError, with_changes
-from .spec import SCALAR_METRICS, Case
+from tmem.batch.encounters import run_batch, unsupported
+from tmem.engine import DIVERGED, simulate
+from tmem.analysis.metrics import summarize
+from tmem.scenario import Scenario, ScenarioError, with_changes
+from tmem.sweep.spec import SCALAR_METRICS, Case
 
 #: The parameter paths a batch takes per case: the two agents' starts.
 START_PATH = re.compile(r"agents\.([01])\.(position|velocity)")

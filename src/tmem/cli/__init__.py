@@ -1,0 +1,1 @@
+"""The command line, ``tmem``: :mod:`tmem.cli.main` (the commands) and :mod:`tmem.cli.terminal` (progress and messages)."""

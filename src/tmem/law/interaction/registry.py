@@ -1,0 +1,88 @@
+"""The interaction functions tmem knows, one row each: (8), Fig. 3, (10) and (11).
+
+This module is the one list of functions.  The scenario schema takes its
+choices from it, :func:`tmem.law.interaction.kernels.pair_control` dispatches on
+its codes, and the documentation's table is written from it.  It imports no
+compiled code, so a scenario can be validated without loading Numba.
+
+A row's ``code`` is its place in :data:`FUNCTIONS`; its ``kernel`` names the
+scalar kernel in :mod:`tmem.law.interaction.kernels`.  Adding a function is one
+kernel there and one row here (see ``docs/architecture.md``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class InteractionFunction:
+    """One interaction function and the properties it claims (tests check each claim).
+
+    Attributes
+    ----------
+    name : str
+        The scenario's ``interaction.function`` value.
+    kernel : str
+        Name of its scalar kernel ``kernel(r, f_en, params)`` in :mod:`tmem.law.interaction.kernels`.
+    equation : str
+        Where the paper gives it.
+    couples : bool
+        Whether it switches on the pair flag ``F_en`` (and so can hold a formation).
+    continuous : bool
+        Whether it is continuous in ``|d|`` while uncoupled (``F_en = 0``).
+    summary : str
+        One line for the documentation's table.
+    """
+
+    name: str
+    kernel: str
+    equation: str
+    couples: bool
+    continuous: bool
+    summary: str
+
+
+FUNCTIONS: tuple[InteractionFunction, ...] = (
+    InteractionFunction(
+        "repulsion", "repulsion", "(8)", couples=False, continuous=True,
+        summary="K_P c inside the spheres, 0 outside: pushes apart",
+    ),
+    InteractionFunction(
+        "attraction", "attraction", "Fig. 3", couples=False, continuous=False,
+        summary="K_P (d - s_d d_t) inside the spheres, 0 outside: apart closer than d_t, together farther",
+    ),
+    InteractionFunction(
+        "switching", "switching", "(10)", couples=True, continuous=True,
+        summary="repulsion (8) while uncoupled; K_P (d - s_d d_t) at any distance while coupled",
+    ),
+    InteractionFunction(
+        "improved", "improved_switching", "(11)", couples=True, continuous=True,
+        summary="a continuous f1 equal to f2 closer than d_t; f2 of (10) while coupled",
+    ),
+)  # fmt: skip
+
+#: The names, in the order of their integer codes.
+FUNCTION_NAMES: tuple[str, ...] = tuple(row.name for row in FUNCTIONS)
+
+
+def code(name: str) -> int:
+    """The integer code of the function called ``name`` (its place in :data:`FUNCTIONS`).
+
+    Parameters
+    ----------
+    name : str
+        A name in :data:`FUNCTION_NAMES`.
+    """
+    return FUNCTION_NAMES.index(name)
+
+
+def uses_coupling(name: str) -> bool:
+    """True for the functions that switch on the pair flag ``F_en``, such as (10) and (11).
+
+    Parameters
+    ----------
+    name : str
+        A name in :data:`FUNCTION_NAMES`.
+    """
+    return FUNCTIONS[code(name)].couples

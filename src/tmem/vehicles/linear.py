@@ -1,0 +1,167 @@
+"""The paper's linear quadrocopter model (1)-(2), stepped by its exact zero-order hold.
+
+The state of one agent along one axis is ``x = (P, V, phi, omega)``:
+position (m), velocity (m/s), tilt from the vertical (rad) and tilt rate
+(rad/s).  The input is the tilt set-point ``U = phi_d`` (rad).  The inner
+attitude loop of (1), ``omega_d = kp (phi_d - phi)`` and
+``omega_dot = kd (omega_d - omega)``, with ``x_ddot = g phi``, gives the
+linear model (2)::
+
+    x_dot = A x + B U
+    A = [[0, 1, 0, 0], [0, 0, g, 0], [0, 0, 0, 1], [0, 0, -kp kd, -kd]]
+    B = [0, 0, 0, kp kd]^T
+
+The model is advanced with the exact zero-order-hold discretisation: between
+two control updates the input is held constant and the state is propagated
+with the matrix exponential, so the only discretisation error is that of
+sampling the control.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba
+import numpy as np
+from scipy.linalg import expm
+
+from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.vehicles.base import VehicleModel
+
+#: Names of the four state components, in the order the arrays use.
+STATE_NAMES = ("P", "V", "phi", "omega")
+
+
+def state_matrices(kp: float, kd: float, g: float) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(A, B)`` of the linear model (2).
+
+    Parameters
+    ----------
+    kp, kd
+        Gains of the inner attitude loop in (1) (1/s).
+    g
+        Gravitational acceleration (m/s^2).
+
+    Returns
+    -------
+    A : ndarray, shape (4, 4)
+    B : ndarray, shape (4,)
+    """
+    a = np.array(
+        [
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, g, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+            [0.0, 0.0, -kp * kd, -kd],
+        ]
+    )
+    b = np.array([0.0, 0.0, 0.0, kp * kd])
+    return a, b
+
+
+def zero_order_hold(a: np.ndarray, b: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Exact zero-order-hold discretisation of ``x_dot = A x + B U``.
+
+    ``x[k+1] = Ad x[k] + Bd U[k]`` with ``Ad = exp(A dt)`` and
+    ``Bd = integral_0^dt exp(A s) ds B``, both read off the exponential of the
+    augmented matrix ``[[A, B], [0, 0]] dt`` (Van Loan's method).
+
+    Parameters
+    ----------
+    a : ndarray, shape (n, n)
+    b : ndarray, shape (n,)
+    dt
+        The time step (s).
+
+    Returns
+    -------
+    Ad : ndarray, shape (n, n)
+    Bd : ndarray, shape (n,)
+    """
+    n = a.shape[0]
+    augmented = np.zeros((n + 1, n + 1))
+    augmented[:n, :n] = a
+    augmented[:n, n] = b
+    m = expm(augmented * dt)
+    return m[:n, :n].copy(), m[:n, n].copy()
+
+
+class HoldStep(NamedTuple):
+    """What one zero-order-hold step needs: ``x <- Ad x + Bd U``."""
+
+    ad: np.ndarray
+    bd: np.ndarray
+
+
+@numba.njit(cache=True, inline="always")
+def hold_step(ad, bd, x0, x1, x2, x3, u):
+    """One zero-order-hold step of one axis, ``Ad x + Bd U``, as four numbers.
+
+    Parameters
+    ----------
+    ad : ndarray, shape (4, 4)
+    bd : ndarray, shape (4,)
+        ``(Ad, Bd)`` of :func:`zero_order_hold`.
+    x0, x1, x2, x3 : float
+        The state ``(P, V, phi, omega)`` (m, m/s, rad, rad/s).
+    u : float
+        The tilt set-point ``U`` held over the step (rad).
+    """
+    return (
+        ad[0, 0] * x0 + ad[0, 1] * x1 + ad[0, 2] * x2 + ad[0, 3] * x3 + bd[0] * u,
+        ad[1, 0] * x0 + ad[1, 1] * x1 + ad[1, 2] * x2 + ad[1, 3] * x3 + bd[1] * u,
+        ad[2, 0] * x0 + ad[2, 1] * x1 + ad[2, 2] * x2 + ad[2, 3] * x3 + bd[2] * u,
+        ad[3, 0] * x0 + ad[3, 1] * x1 + ad[3, 2] * x2 + ad[3, 3] * x3 + bd[3] * u,
+    )
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def step_zero_order_hold(x, body, u, i, scale, params, n_axes):
+    """Advance agent ``i`` of ``x`` (agents, axes, 4) over one step with ``U = u[i] * scale`` held (2).
+
+    Parameters
+    ----------
+    x : ndarray, shape (agents, axes, 4)
+        States, changed in place.
+    body : ndarray, shape (agents, 0)
+        The body states: the linear model has none.
+    u : ndarray, shape (agents, axes)
+        Summed tilt set-points (rad).
+    i : int
+        The agent.
+    scale : float
+        Saturation factor of ``u[i]`` (:func:`tmem.law.modal.tilt_scale`).
+    params : HoldStep
+        ``(Ad, Bd)`` for the time step.
+    n_axes : int
+        Number of axes.
+    """
+    for a in range(n_axes):
+        x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3] = hold_step(
+            params.ad, params.bd, x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3], u[i, a] * scale
+        )
+
+
+class LinearModel(VehicleModel):
+    """The linear model (2) of each horizontal axis, with the parameters ``kp``, ``kd``, ``g`` of Table 1."""
+
+    kind = "linear"
+    state_names = STATE_NAMES
+    state_units = ("m", "m s-1", "rad", "rad s-1")
+    long_names = ("position", "velocity", "tilt from the vertical", "tilt rate")
+    step = step_zero_order_hold
+
+    def linearisation(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, B)`` of (2): the model is its own linearisation."""
+        p = self.params
+        return state_matrices(p.kp, p.kd, p.g)
+
+    def step_params(self, dt: float) -> HoldStep:
+        """``(Ad, Bd)`` of the exact zero-order hold over ``dt``.
+
+        Parameters
+        ----------
+        dt : float
+            The time step (s).
+        """
+        return HoldStep(*zero_order_hold(*self.linearisation(), dt))
