@@ -12,7 +12,8 @@ missing on either side, or an array differs by more than ``--rtol``
 
 Only the API likely to outlive a refactor is used: ``tmem.preset``,
 ``tmem.load`` / ``tmem.loads``, ``tmem.scenario.with_changes``,
-``tmem.simulate``, ``tmem.analysis.metrics.summarize`` and ``tmem.batch.encounters.run_batch``.
+``tmem.simulate``, ``tmem.summarize``, ``tmem.run_batch`` and ``tmem.agent.fly`` (in a
+tree from before ``summarize`` and ``run_batch`` were top-level names, their modules').
 A run's pinned arrays are the trajectory's ``time``, ``state``, ``control``,
 ``active``, ``flag``, ``pair_distance``, ``interaction_distance``,
 ``min_distance``, ``min_neighbor_distance``, ``final_state`` and
@@ -25,7 +26,10 @@ The items (the scenario inputs come from this tree's ``examples/`` unless
 ``--examples`` names another):
 
 * the presets fig5, fig7, fig9, repulsion (default dt);
-* every scenario under ``examples/`` and ``examples/swarm/``;
+* every scenario under ``examples/``, ``examples/swarm/`` and ``examples/sensing/``; those under
+  ``examples/vehicles/`` (the quadrotor), the pairs at dt = 1 ms, the hexes for their first 10 s;
+* examples/fig9.toml (dt = 1 ms, 40 s) and the 19-agent hex (3 s) flown by one controller per
+  agent (``tmem.agent.fly``);
 * gas-N, 2-D, N = 1000 and 10 000, as benchmarks/bench_gas.py builds it
   (1000 steps, final state); a 3-D periodic gas of 2000 agents, 300 steps;
 * formations: the 19-agent hex (jitter 1 m) for 20 s; a 12-agent ring that
@@ -125,13 +129,31 @@ def numeric_fields(node, path: str) -> dict[str, np.ndarray]:
 def run_arrays(scenario) -> dict[str, np.ndarray]:
     """Simulate ``scenario``; the trajectory's pinned arrays, its events and its summary's numbers."""
     import tmem
-    from tmem.analysis.metrics import summarize
 
     trajectory = tmem.simulate(scenario)
     arrays = {name: np.asarray(getattr(trajectory, name)) for name in TRAJECTORY_FIELDS if hasattr(trajectory, name)}
     if hasattr(trajectory, "events"):
         arrays["events"] = np.array([event_text(e) for e in trajectory.events], dtype=str)
-    arrays.update(numeric_fields(summarize(trajectory), "summary"))
+    arrays.update(numeric_fields(_api("summarize", "metrics")(trajectory), "summary"))
+    return arrays
+
+
+def _api(name: str, old_module: str):
+    """``tmem.<name>``, or, in a tree from before it was a top-level name, ``tmem.<old_module>.<name>``."""
+    import importlib
+
+    import tmem
+
+    return getattr(tmem, name) if name in getattr(tmem, "__all__", ()) else getattr(importlib.import_module(f"tmem.{old_module}"), name)
+
+
+def flight_arrays(scenario) -> dict[str, np.ndarray]:
+    """Fly ``scenario`` with one controller per agent (``tmem.agent.fly``): its recorded arrays and events."""
+    from tmem.agent import fly
+
+    flight = fly(scenario)
+    arrays = {name: np.asarray(getattr(flight, name)) for name in ("time", "state", "control", "flag", "final_state")}
+    arrays["events"] = np.array([event_text(e) for e in flight.events], dtype=str)
     return arrays
 
 
@@ -207,9 +229,9 @@ def sweep_cases(path: Path) -> tuple[object, list[tuple[dict, list[tuple[int, di
 
 def encounter_arrays(path: Path, grid_point: int) -> dict[str, np.ndarray]:
     """One grid point of the encounter study on ``run_batch``: every BatchResult array and the starts."""
-    from tmem.batch.encounters import run_batch
     from tmem.scenario import with_changes
 
+    run_batch = _api("run_batch", "batch")
     base, points = sweep_cases(path)
     setting, cases = points[grid_point]
     starts = np.array(
@@ -235,6 +257,16 @@ def items(examples: Path) -> list[Item]:
     for path in sorted(examples.glob("*.toml")) + sorted(examples.glob("swarm/*.toml")):
         relative = path.relative_to(examples).as_posix()
         found.append(Item(f"example-{path.stem}", f"examples/{relative} as shipped", load(relative)))
+    for path in sorted(examples.glob("sensing/*.toml")):
+        found.append(Item(f"sensing-{path.stem}", f"examples/sensing/{path.name} as shipped", load(f"sensing/{path.name}")))
+    for path in sorted(examples.glob("vehicles/*.toml")):
+        changes = {"simulation.duration": 10.0} if path.stem.startswith("hex") else {"simulation.dt": 0.001}
+        found.append(Item(f"vehicles-{path.stem}", f"examples/vehicles/{path.name} with {changes}",
+                          load(f"vehicles/{path.name}", changes)))
+    for name, changes in (("fig9", {"simulation.duration": 40.0, "simulation.dt": 0.001}),
+                          ("swarm/hex19", {"simulation.duration": 3.0})):
+        found.append(Item(f"agents-{Path(name).name}", f"examples/{name}.toml flown by one controller per agent, {changes}",
+                          lambda name=name, changes=changes: flight_arrays(with_changes(tmem.load(examples / f"{name}.toml"), changes))))
     for n in (1000, 10000):
         what = f"gas-{n} of benchmarks/bench_gas.py: 2-D, {GAS_STEPS} steps of 0.01 s, recorded at start and end"
         found.append(Item(f"gas-{n}", what, lambda n=n: run_arrays(tmem.loads(gas_toml(n, 2, GAS_STEPS, seed=1)))))

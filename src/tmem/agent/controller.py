@@ -215,7 +215,7 @@ class AgentController:
             The time (s).
         """
         vectors = np.empty((3, self.settings.axes))
-        message_vectors(self._own(own_state), self._gains, vectors)
+        message_vectors(self._own(own_state)[np.newaxis], self._gains, vectors)
         return AgentMessage(self.agent, float(t), True, vectors)
 
     def update(self, own_state, messages: Iterable[AgentMessage], t: float) -> np.ndarray:

@@ -37,10 +37,11 @@ import numpy as np
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law.modal import corrected_position, tilt_scale
 from tmem.engine.pairs import formation_pair
-from tmem.engine.records import Agents, Counters, Events, Law, Pairs
+from tmem.engine.records import Agents, Counters, Events, Pairs
+from tmem.law.record import Law
 from tmem.law.interaction.kernels import FunctionParams, push_factor
 
-#: The integer and the real numbers of the law (:class:`tmem.engine.records.Law` and
+#: The integer and the real numbers of the law (:class:`tmem.law.record.Law` and
 #: :class:`tmem.law.interaction.kernels.FunctionParams`), in their rows of :func:`law_tables`.
 LAW_INTS = ("function", "neighbour_function", "couples", "at_crossing", "uncouple_rule", "fallback_steps")
 LAW_FLOATS = ("eps", "energy_tolerance", "sync_gain", "k_p", "reach", "d_t", "c_max")
@@ -67,7 +68,7 @@ def law_tables(law: Law, params: FunctionParams) -> tuple[np.ndarray, np.ndarray
 
 @numba.njit(cache=True, inline="always")
 def law_from(gains, ints, floats):
-    """The :class:`~tmem.engine.records.Law` and :class:`~tmem.law.interaction.kernels.FunctionParams`
+    """The :class:`~tmem.law.record.Law` and :class:`~tmem.law.interaction.kernels.FunctionParams`
     held in the arrays of :func:`law_tables`.
 
     Parameters
@@ -124,17 +125,17 @@ def message_vectors(own, gains, out):
 
     Parameters
     ----------
-    own : ndarray, shape (axes, n_state)
+    own : ndarray, shape (1, axes, n_state)
         The agent's state, ``(P, V, phi, omega)`` first.
     gains : ndarray, shape (1, 4)
         The agent's ``K``.
     out : ndarray, shape (3, axes)
         Filled with ``P*`` (m), ``P`` (m) and ``V`` (m/s).
     """
-    for a in range(own.shape[0]):
-        out[0, a] = corrected_position(own[a, 0], own[a, 1], own[a, 2], own[a, 3], gains, 0)
-        out[1, a] = own[a, 0]
-        out[2, a] = own[a, 1]
+    for a in range(own.shape[1]):
+        out[0, a] = corrected_position(own, 0, a, gains, 0)
+        out[1, a] = own[0, a, 0]
+        out[2, a] = own[0, a, 1]
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -179,7 +180,7 @@ def control(k, own, gains, law_ints, law_floats, inbox, known, active, corrected
     for a in range(n_axes):
         for m in range(known.shape[2]):  # (P, V, phi, omega): what the law reads of a state
             known[0, a, m] = own[a, m]
-        corrected[0, a, 0] = corrected_position(own[a, 0], own[a, 1], own[a, 2], own[a, 3], gains, 0)
+        corrected[0, a, 0] = corrected_position(known, 0, a, gains, 0)
         corrected[0, a, 1] = own[a, 0]
         setpoint[0, a] = 0.0
         for row in range(1, inbox.shape[0]):

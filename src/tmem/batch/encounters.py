@@ -31,7 +31,8 @@ import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law import coupling
-from tmem.law.modal import corrected_position, gains_for, tilt_scale
+from tmem.batch.free_flight import level
+from tmem.law.modal import corrected_position, gains_for, gains_row, tilt_scale
 from tmem.law.record import law_of
 from tmem.engine.pairs import formation_pair
 from tmem.engine.records import Agents, Counters, Events, Pairs
@@ -109,7 +110,7 @@ def _is_free(x, e, pairs, r, reach):
         return False
     for s in (pairs.i[e], pairs.j[e]):
         for a in range(x.shape[1]):
-            if abs(x[s, a, 2]) >= 1e-13 or abs(x[s, a, 3]) >= 1e-12:
+            if not level(x, s, a):
                 return False
     return True
 
@@ -127,7 +128,7 @@ def _case_step(k, e, x, agents, pairs, law, params, box, hold, command_step, n_s
     r2 = 0.0
     for s in (i, j):
         for a in range(n_axes):
-            agents.corrected[s, a, 0] = corrected_position(x[s, a, 0], x[s, a, 1], x[s, a, 2], x[s, a, 3], law.gains, s - i)
+            agents.corrected[s, a, 0] = corrected_position(x, s, a, law.gains, gains_row(law.gains, s - i))
             agents.corrected[s, a, 1] = x[s, a, 0]
             agents.setpoint[s, a] = 0.0
     for a in range(n_axes):

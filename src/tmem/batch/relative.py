@@ -22,6 +22,7 @@ import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law import coupling
+from tmem.batch.free_flight import level, steps_before_contact
 from tmem.law.modal import corrected_position
 from tmem.law.interaction.kernels import pair_control
 from tmem.vehicles.linear import hold_step
@@ -32,38 +33,26 @@ LANES = 8
 
 
 @numba.njit(cache=True, inline="always")
-def _free_flight_steps(d, velocity, steps_left, gap, dt):
-    """Steps a free pair (uncoupled, level, ``gap`` m beyond reach and window) may skip: every step
-    left if it separates (``d`` grows), else those before it could close the gap at ``velocity``."""
-    closing = -velocity if d > 0 else velocity
-    if closing <= 0.0:
-        return steps_left
-    return min(steps_left, int(gap / (closing * dt)) - 1)
-
-
-@numba.njit(cache=True, inline="always")
 def _lane_states(e0, first, lanes):
-    """The relative states ``(P, V, phi, omega)`` of the ``lanes`` cases from ``first``, one array each
-    of :data:`LANES` slots."""
-    e_p = np.empty(LANES)
-    e_v = np.empty(LANES)
-    e_phi = np.empty(LANES)
-    e_om = np.empty(LANES)
+    """The relative states ``(P, V, phi, omega)`` of the ``lanes`` cases from ``first``, a row each of
+    an array of :data:`LANES` rows, on one axis."""
+    e = np.empty((LANES, 1, e0.shape[1]))
     for lane in range(lanes):
-        e_p[lane], e_v[lane], e_phi[lane], e_om[lane] = e0[first + lane]
-    return e_p, e_v, e_phi, e_om
+        for m in range(e0.shape[1]):
+            e[lane, 0, m] = e0[first + lane, m]
+    return e
 
 
 @numba.njit(cache=True, inline="always")
-def _skip_free_flight(e_p, e_v, armed, r_before, k, c, d, gap, n_steps, command_step, dt):
-    """Skip case ``c``'s free flight in closed form (:func:`_free_flight_steps`), the command disarming
-    it if due on the way; whether there was more than one step to skip."""
-    skip = _free_flight_steps(d, e_v[c], n_steps - k[c], gap, dt)
+def _skip_free_flight(e, armed, r_before, k, c, d, gap, n_steps, command_step, dt):
+    """Skip case ``c``'s free flight in closed form (:func:`tmem.batch.free_flight.steps_before_contact`),
+    the command disarming it if due on the way; whether there was more than one step to skip."""
+    skip = steps_before_contact(d, e[c, 0, 1], n_steps - k[c], gap, dt)
     if skip <= 1:
         return False
     if k[c] < command_step <= k[c] + skip:
         armed[c] = 0
-    e_p[c] += e_v[c] * (skip * dt)
+    e[c, 0, 0] += e[c, 0, 1] * (skip * dt)
     k[c] += skip
     r_before[c] = np.nan
     return True
@@ -123,7 +112,7 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
     for block in numba.prange((n_cases + LANES - 1) // LANES):
         first = block * LANES
         lanes = min(LANES, n_cases - first)
-        e_p, e_v, e_phi, e_om = _lane_states(e0, first, lanes)
+        e = _lane_states(e0, first, lanes)
         flag = np.zeros(LANES, dtype=np.int64)
         armed = np.ones(LANES, dtype=np.int64)
         r_before = np.full(LANES, np.nan)
@@ -140,23 +129,25 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
                 running += 1
                 if k[c] == command_step:
                     armed[c] = 0
-                d = corrected_position(e_p[c], e_v[c], e_phi[c], e_om[c], gains, 0)
+                d = corrected_position(e, c, 0, gains, 0)
                 r = abs(d)
-                lowest[c] = min(lowest[c], abs(e_p[c]))
+                lowest[c] = min(lowest[c], abs(e[c, 0, 0]))
                 # Free flight: uncoupled, out of reach, level (the tilt has died out).  Then
                 # d = P + (K_V / K_P) V moves at the constant rate V, so the flight is skipped in
                 # closed form: to the end if the pair separates, else to just before it meets.
-                if flag[c] == 0 and r > reach + eps and abs(e_phi[c]) < 1e-13 and abs(e_om[c]) < 1e-12 and k[c] < n_steps:
-                    if _skip_free_flight(e_p, e_v, armed, r_before, k, c, d, r - reach - eps, n_steps, command_step, dt):
+                if flag[c] == 0 and r > reach + eps and level(e, c, 0) and k[c] < n_steps:
+                    if _skip_free_flight(e, armed, r_before, k, c, d, r - reach - eps, n_steps, command_step, dt):
                         continue
                 if couples:
                     _flag_step(flag, armed, r_before, coupled_at, uncoupled_at, c, k[c], r, d_t, eps, at_crossing)
                 u0 = _push_on_first(function, r, flag[c], params, d, c_max)
                 if k[c] < n_steps:
-                    e_p[c], e_v[c], e_phi[c], e_om[c] = hold_step(ad, bd, e_p[c], e_v[c], e_phi[c], e_om[c], -2.0 * u0)
+                    e[c, 0, 0], e[c, 0, 1], e[c, 0, 2], e[c, 0, 3] = hold_step(ad, bd, e[c, 0, 0], e[c, 0, 1], e[c, 0, 2],
+                                                                               e[c, 0, 3], -2.0 * u0)
                 k[c] += 1
         for lane in range(lanes):
-            e_end[first + lane] = (e_p[lane], e_v[lane], e_phi[lane], e_om[lane])
+            for m in range(e0.shape[1]):
+                e_end[first + lane, m] = e[lane, 0, m]
             min_dist[first + lane] = lowest[lane]
             couple_step[first + lane] = coupled_at[lane]
             uncouple_step[first + lane] = uncoupled_at[lane]

@@ -48,7 +48,9 @@ from tmem.law.interaction.kernels import FunctionParams
 from tmem.files.outputs import write_atomically
 from tmem.scenario import Scenario
 from tmem.world.sensing import Sensing
-from tmem.engine.records import Agents, Commands, Counters, Events, Gas, Law, Neighbours, Pairs, Records, Run
+from tmem.engine.records import Agents, Commands, Counters, Events, Gas, Neighbours, Pairs, Records, Run
+from tmem.law.record import Law
+from tmem.terms import term_class
 
 #: The records that change during a run, under the names a checkpoint gives their fields.
 CHANGING = {
@@ -76,12 +78,12 @@ REBUILT = {
         "block_nearest2": _WORK, "block_shift2": _WORK, "chunks": _WORK,
     },
     "gas": {
-        **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "every", "wall_reach", "c_max"), _FIXED),
+        **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "every", "wall_reach", "k_p", "c_max"), _FIXED),
         "work": _COUNTED, "pushed": _WORK,
     },
     "sensing": {
-        **dict.fromkeys((f for f in Sensing._fields if f not in ("history", "own", "pair_states", "pushes", "work")), _FIXED),
-        **dict.fromkeys(("own", "pair_states", "pushes", "work"), _WORK),
+        **dict.fromkeys((f for f in Sensing._fields if f not in ("history", "own", "pair_states", "seen", "pushes", "work")), _FIXED),
+        **dict.fromkeys(("own", "pair_states", "seen", "pushes", "work"), _WORK),
     },
 }  # fmt: skip
 #: Fields filled row by row, and the counter of filled rows: a checkpoint holds those rows only.
@@ -172,11 +174,15 @@ def made_by() -> str:
 
 
 def _arrays(state: dict) -> dict[str, tuple[np.ndarray, str | None]]:
-    """Every array a checkpoint holds, by ``record.field``, with the counter of its filled rows (or None)."""
+    """Every array a checkpoint holds, by ``record.field`` (an agent term's by ``terms.NAME.field``), with
+    the counter of its filled rows (or None)."""
+    fields = [(name, state[name], saved_fields(name)) for name in CHANGING]
+    for term, record in state.get("terms", {}).items():  # each declares what it rebuilds (tmem.terms.base)
+        fields.append((f"terms.{term}", record, [f for f in record._fields if f not in term_class(term).rebuilt]))
     found = {}
-    for name in CHANGING:
-        for f in saved_fields(name):
-            value = getattr(state[name], f)
+    for name, record, saved in fields:
+        for f in saved:
+            value = getattr(record, f)
             if not isinstance(value, np.ndarray):
                 raise TypeError(f"{name}.{f} is not an array: save it as one, or declare it in REBUILT")
             found[f"{name}.{f}"] = (value, ROWS.get((name, f)))
@@ -304,7 +310,7 @@ class Checkpoints:
         step : int
             The step the run stands at (not yet taken).
         state : dict
-            The run's :data:`CHANGING` records, by name.
+            The run's :data:`CHANGING` records, by name, and its agent terms' records (``terms``: by name).
         list_builds : int
             How often the neighbour lists have been built.
         """

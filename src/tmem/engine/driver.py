@@ -17,6 +17,7 @@ from __future__ import annotations
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
@@ -30,6 +31,7 @@ from tmem.scenario.sensing_table import SensingParams
 from tmem.world.sensing import exact, sensing_of
 from tmem.engine.checkpoint import Checkpoints, Saved, restore
 from tmem.engine.loop import advance_for
+from tmem.engine.variants import Variant
 from tmem.engine.pushes import CHUNK
 from tmem.engine.gas import SNAPSHOT, TOTALS, gas_record
 from tmem.law.record import law_of
@@ -37,7 +39,7 @@ from tmem.engine.records import (
     COMMANDS, LISTS_STALE, Agents, Commands, Counters, Events, Neighbours, Pairs, Records, Run,
 )  # fmt: skip
 from tmem.engine.trajectory import DIVERGED, SimulationError, Trajectory, read_events
-from tmem.world.walls import wall_params
+from tmem.terms import term_class
 
 #: Swarms at least this large step on threads: below, starting the threads at every step costs more
 #: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal
@@ -266,10 +268,12 @@ def simulate(
     swarm = _in_slots(scenario, initial, gains, record, model.initial_body(initial.state))
     x = swarm.agents.state
     lister, measured, sensed = _lists_and_measurement(scenario, run, swarm, gains, sensing)
-    gas = gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0])
-    advance = advance_for(type(model), x.shape[0] >= THREADED_SWARM, sensed, gas.observe)
-    stages = (law, params, model.step_params(sim.dt), measured, gas, wall_params(params, gas.wall_reach))
-    _drive(advance, run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)
+    terms = {name: term_class(name).record(getattr(scenario, name), scenario, gains) for name in scenario.agent_terms}
+    stages = Stages(law=law, params=params, vehicle=model.step_params(sim.dt), knowledge=measured,
+                    gas=gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0], float(gains[0])), terms=terms)
+    variant = Variant(vehicle=scenario.model.kind, knowledge="sensed" if sensed else "exact", terms=tuple(terms),
+                      gas=stages.gas.observe, threaded=x.shape[0] >= THREADED_SWARM)  # fmt: skip
+    _drive(advance_for(variant), run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)
     if not np.all(np.isfinite(x[swarm.agents.active])):
         raise SimulationError(DIVERGED)
     return _read_back(scenario, initial, model, gains, swarm, lister)
@@ -342,21 +346,46 @@ def _run_of(scenario: Scenario, initial: InitialArrays, record: bool) -> Run:
     return Run(sim.n_steps, sim.record_every if record else 0, box, use_lists, scenario.neighbors.skin)
 
 
-def _changing(swarm: _Slots, neighbours: Neighbours, stages: tuple) -> dict:
+class Stages(NamedTuple):
+    """The records of the law and of the stages that a run binds, by name.
+
+    Attributes
+    ----------
+    law : Law
+        The TMEM law (:mod:`tmem.law.record`).
+    params : FunctionParams
+        The interaction functions' parameters.
+    vehicle : NamedTuple
+        The vehicle model's numbers for a step (:meth:`tmem.vehicles.base.VehicleModel.step_params`).
+    knowledge : Sensing
+        The measurement stage (:mod:`tmem.world.sensing`; unused under exact knowledge).
+    gas : Gas
+        The gas (:mod:`tmem.engine.gas`; its arrays empty when it is not observed).
+    terms : dict of str to NamedTuple
+        Each agent term's record, by its table's name, in the order they push (:mod:`tmem.terms`).
+    """
+
+    law: Any
+    params: Any
+    vehicle: Any
+    knowledge: Any
+    gas: Any
+    terms: dict
+
+
+def _changing(swarm: _Slots, neighbours: Neighbours, stages: Stages) -> dict:
     """The records a step changes, by the names of :data:`tmem.engine.checkpoint.CHANGING`."""
-    _, _, _, sensing, gas, _ = stages
     return dict(agents=swarm.agents, pairs=swarm.pairs, neighbours=neighbours, records=swarm.records, events=swarm.events,
-                counters=swarm.counters, gas=gas, sensing=sensing)  # fmt: skip
+                counters=swarm.counters, gas=stages.gas, sensing=stages.knowledge, terms=stages.terms)  # fmt: skip
 
 
-def _drive(advance, run: Run, stages: tuple, swarm: _Slots, lister: _NeighbourLister, progress, chunk_seconds: float,
+def _drive(advance, run: Run, stages: Stages, swarm: _Slots, lister: _NeighbourLister, progress, chunk_seconds: float,
            checkpoints: Checkpoints | None, resume: Saved | None) -> None:  # fmt: skip
     """Run the compiled loop ``advance`` over every step, in chunks of about ``chunk_seconds``,
-    listing the neighbours again whenever the loop asks.  ``stages`` are the records of the law and
-    the stages: ``(law, params, vehicle, sensing, gas, wall_params)``.  With ``checkpoints``, chunks
-    end at the checkpoints' steps, where the run is saved; with ``resume``, the run goes on from it,
-    its neighbours listed again from ``P*`` at their last build."""
-    law, params, vehicle, sensing, gas, walls = stages
+    listing the neighbours again whenever the loop asks.  With ``checkpoints``, chunks end at the
+    checkpoints' steps, where the run is saved; with ``resume``, the run goes on from it, its
+    neighbours listed again from ``P*`` at their last build."""
+    terms = tuple(stages.terms.values())
     neighbours = lister.list(swarm.agents.active, run.box)
     if resume is not None:
         restore(resume, _changing(swarm, neighbours, stages))
@@ -368,8 +397,8 @@ def _drive(advance, run: Run, stages: tuple, swarm: _Slots, lister: _NeighbourLi
         started = _time.perf_counter()
         at = checkpoints.due(counters.step[0]) if checkpoints is not None else run.n_steps + 1
         stop = min(counters.step[0] + chunk, run.n_steps + 1, at)
-        status = advance(stop, run, law, params, vehicle, sensing, swarm.agents, swarm.pairs, neighbours, swarm.commands,
-                         swarm.records, swarm.events, counters, gas, walls)  # fmt: skip
+        status = advance(stop, run, stages.law, stages.params, stages.vehicle, stages.knowledge, swarm.agents, swarm.pairs,
+                         neighbours, swarm.commands, swarm.records, swarm.events, counters, stages.gas, terms)  # fmt: skip
         if status == LISTS_STALE:
             neighbours = lister.list(swarm.agents.active, run.box)  # and go on from the same step
             continue

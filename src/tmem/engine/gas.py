@@ -34,6 +34,7 @@ from tmem.scenario import ThermostatParams
 from tmem.world.space import nearest_image
 from tmem.engine.gas_columns import COMMON, CONTACT, NEAR, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL
 from tmem.engine.records import Gas
+from tmem.law.interaction.kernels import FunctionParams
 from tmem.engine.thermostat import add_thermostat_push, hold_group_push
 from tmem.world.walls import keep_off, wall_pushes, with_priority
 
@@ -155,8 +156,29 @@ def add_contact(i, j, near, pressing, virial, pair_virial, work, known):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, first):
-    """Agent ``i``'s part of :func:`gas_pushes`."""
+def gas_agent(i, known, agents, gas, box, counting, first):
+    """Agent ``i``'s walls and obstacles (W1), thermostat (T1), (T3), then the walls' last word (W2),
+    after every other push; at a count, the weights of the mean of pushes (C1), the thermostat's group
+    push, and the neighbours that came within reach.  The gas's agent term: the last of the agent
+    terms (:mod:`tmem.engine.terms`), bound only where the gas is observed.
+
+    Parameters
+    ----------
+    i : int
+        The agent's slot.
+    known : ndarray, shape (agents, axes, n_state)
+        The states as measured.
+    agents, gas
+        The loop's records (:mod:`tmem.engine.records`); ``agents.setpoint`` and ``gas`` change in place.
+    box : tuple of float
+        The periodic box's sides (0: open axis).
+    counting : bool
+        Whether the step is a count.
+    first : bool
+        Whether it is the first count (the neighbours present at the start are not encounters).
+    """
+    corrected, setpoint = agents.corrected, agents.setpoint
+    wall_params = FunctionParams(gas.k_p, gas.wall_reach, 0.0, gas.c_max)  # the repulsion (8), with R + R_w
     n_axes = len(box)
     walls = gas.walls
     obstacles = gas.obstacles
@@ -206,67 +228,65 @@ def _gas_agent(i, known, corrected, setpoint, gas, wall_params, box, counting, f
             work[i, VIRIAL] = others * (work[i, VIRIAL] + dropped_virial) + obstacles_virial
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def gas_pushes(known, agents, gas, wall_params, run, n_blocks, counting):
-    """Walls and obstacles (W1), the thermostat (T1), (T3), then the walls' last word (W2), agent by
-    agent (:func:`_gas_agent`), after the neighbour pushes and the formation pairs; at a count, the
-    weights of the mean of pushes (C1), the thermostat's group pushes, and the neighbours that came
-    within reach.
-
-    Parameters
-    ----------
-    known : ndarray, shape (agents, axes, n_state)
-        The states as measured.
-    agents, gas, run
-        The loop's records (:mod:`tmem.engine.records`); ``agents`` and ``gas`` change in place.
-    wall_params : tmem.law.interaction.kernels.FunctionParams
-        The repulsion's parameters with ``R + R_w`` for its reach.
-    n_blocks : int
-        Blocks of agents the parallel loop shares out (those of :func:`tmem.engine.stages.corrected_positions`).
-    counting : bool
-        Whether the step is a count.
-    """
-    box = run.box
-    first = gas.first[0]
-    if counting:
-        gas.first[0] = False
-    n_agents = known.shape[0]
-    per_block = (n_agents + n_blocks - 1) // n_blocks
-    for b in numba.prange(n_blocks):
-        _gas_block(b * per_block, min(n_agents, (b + 1) * per_block), known, agents, gas, wall_params, box, counting,
-                   first)  # fmt: skip
-
-
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _gas_block(begin, end, known, agents, gas, wall_params, box, counting, first):
-    """Agents ``begin:end`` of :func:`gas_pushes`, one after the other.
-
-    Called, not inlined, once per block of agents: compiled once, the gas's code stays out of the
-    step loop's compilation, and out of Numba's transform of the parallel loop.  Inlined in the
-    parallel loop, the agent's code gave the threaded loop other totals than the serial one (Numba's
-    diagnostics show constant assignments of that code moved out of the loop).  A call per agent
-    cost more than the agent's work (its records passed each time); a call per block costs nothing."""
-    for i in range(begin, end):
-        if agents.active[i]:
-            _gas_agent(i, known, agents.corrected, agents.setpoint, gas, wall_params, box, counting, first)
-
-
 @numba.njit(cache=True, inline="always")
-def tilt_limit(observe, limit, i, c_max):
-    """Agent ``i``'s tilt limit this step: ``c_max``, or more in a corner (:func:`tmem.world.walls.with_priority`).
+def limit_of(i, gas, c_max):
+    """Agent ``i``'s tilt limit this step: ``c_max``, or, where the gas is observed, the limit its walls
+    and thermostat set (:func:`tmem.world.walls.with_priority`, :mod:`tmem.engine.thermostat`).
 
     Parameters
     ----------
-    observe : bool
-        Whether the gas is observed (``Gas.observe``; else ``limit`` is empty).
-    limit : ndarray, shape (agents,)
-        ``Gas.limit``.
     i : int
         The agent's slot.
+    gas : Gas
+        The gas's record (``limit`` is empty when it is not observed).
     c_max : float
         The scenario's tilt limit (rad).
     """
-    return limit[i] if observe else c_max
+    return gas.limit[i] if gas.observe else c_max
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def count_pair(e, agents, pairs, law, params, run, gas, counting):
+    """For the gas: formation pair ``e``, if within reach, with no coupling flag (the tracked pairs of a
+    small swarm) is a plain neighbour, and the mean of pushes (C1) divides its push too; at a count,
+    it is counted as the neighbour stage counts its pairs.  ``pairs.d`` holds its push on ``i``
+    (:func:`tmem.engine.pairs.formation_pair` leaves it there).
+
+    Parameters
+    ----------
+    e : int
+        The pair.
+    agents, pairs, law, run, gas
+        The loop's records; ``agents.setpoint`` and ``gas`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters.
+    counting : bool
+        Whether the step is a count.
+    """
+    i = pairs.i[e]
+    j = pairs.j[e]
+    if not (agents.active[i] and agents.active[j]) or not pairs.r_before[e] < params.reach:
+        return
+    box = run.box
+    n_axes = len(box)
+    d = pairs.d
+    size2 = 0.0
+    for a in range(n_axes):
+        size2 += d[a] * d[a]
+    pressing = size2 / (params.c_max * params.c_max)
+    if gas.mean and not law.couples:
+        share = pair_share(i, j, gas.weight)
+        if share < 1.0:
+            for a in range(n_axes):
+                agents.setpoint[i, a] -= (1.0 - share) * d[a]
+                agents.setpoint[j, a] += (1.0 - share) * d[a]
+                d[a] *= share
+    if not counting:
+        return
+    virial = 0.0
+    for a in range(n_axes):
+        virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
+    add_contact(i, j, 1.0, pressing, virial, virial_by_pairs(gas.walls), gas.work, agents.state)
 
 
 @numba.njit(cache=True, inline="always")
@@ -343,7 +363,7 @@ def record_totals(agents, gas, records, q, n_axes):
             records.gas[q, n_totals + 1] += 1.0
 
 
-def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
+def gas_record(scenario, acceleration_per_tilt: float, n_agents: int, k_p: float) -> Gas:
     """The :class:`~tmem.engine.records.Gas` record of a scenario, with its work space for ``n_agents``.
 
     Parameters
@@ -354,6 +374,8 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         ``g``: the acceleration a tilt of one radian gives (``A[1, 2]`` of the vehicle's linearisation).
     n_agents : int
         Agents of the run.
+    k_p : float
+        ``K_P`` of the law: the walls' repulsion (8) pushes with it.
     """
     observe = scenario.gas_observed
     size = n_agents if observe else 0
@@ -375,6 +397,7 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         walls=walls,
         obstacles=obstacles,
         wall_reach=scenario.wall_reach,
+        k_p=k_p,
         c_max=scenario.interaction.c_max,
         first=np.ones(1, dtype=np.bool_),
         work=np.zeros((size, NEIGHBOUR_VELOCITY + space.axes)),
@@ -385,3 +408,60 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
         pushed=np.zeros((size, space.axes)),
         totals=np.zeros((size, len(TOTALS))),
     )
+
+
+@numba.njit(inline="always")
+def _count_every(k, gas):
+    return k % gas.every == 0
+
+
+@numba.njit(inline="always")
+def _first_count(gas, counting):
+    first = gas.first[0]
+    if counting:
+        gas.first[0] = False
+    return first
+
+
+@numba.njit(inline="always")
+def _held_limit(i, gas, c_max):
+    return gas.limit[i]
+
+
+@numba.njit(cache=True, _nrt=False)
+def _tally_step(x, i, scale, gas, box, n_axes, sampled):
+    # Called, not inlined: it writes into the record's arrays from inside the vehicles' parallel
+    # loop, and inlined there its writes were lost on threads (the totals stayed 0).
+    tally(x, i, scale, gas.work, gas.totals, gas.walls, gas.obstacles, box, gas.g_dt, gas.dt, n_axes, sampled)
+
+
+@numba.njit(inline="always")
+def _never(k, gas):
+    return False
+
+
+@numba.njit(inline="always")
+def _no_pair_count(e, agents, pairs, law, params, run, gas, counting):
+    return False
+
+
+@numba.njit(inline="always")
+def _no_tally(x, i, scale, gas, box, n_axes, sampled):
+    return False
+
+
+@numba.njit(inline="always")
+def _scenario_limit(i, gas, c_max):
+    return c_max
+
+
+#: What the loop binds for the gas's observers (:mod:`tmem.engine.loop`), observed or not: when the
+#: counts are due, the count of a formation pair, an agent's tilt limit, the tally after its step,
+#: and whether a count is the first.  A run without the gas's options steps its agents in a loop with
+#: none of them (with their branches, the vehicles' step took a fifth longer on 3·10^4 agents).
+OBSERVERS = {
+    True: lambda: dict(counts_due=_count_every, count_pair=count_pair, tilt_limit=_held_limit, after_step=_tally_step,
+                       first_count=_first_count),
+    False: lambda: dict(counts_due=_never, count_pair=_no_pair_count, tilt_limit=_scenario_limit, after_step=_no_tally,
+                        first_count=_never),
+}  # fmt: skip

@@ -1,75 +1,54 @@
-"""The step loop: the stages of :mod:`tmem.engine.stages` in order, compiled once per vehicle model.
+"""The step loop: the stages of one step in order, each stage that varies called by a name the variant binds.
 
-:func:`advance_for` gives the loop of a vehicle model, serial or on threads.
-The loop's source is written once (:func:`_advance_source`); each model gets
-its own compiled copy with the model's step kernel bound to the name
-``vehicle_step``, so the model's step is inlined and a model costs nothing at
-run time.  Each copy has a name of its own: Numba keys its on-disk cache by
-the function's name, not by ``parallel`` or by what a global name is bound
-to, and copies sharing a name would stand in for each other.
+:func:`advance_for` gives the compiled loop of a :class:`~tmem.engine.variants.Variant`.  The
+loop's source, :func:`_advance_source`, is written once; it calls the stages that vary by these
+names, which the variant binds (:func:`tmem.engine.variants.bound`):
 
-Both loops are compiled without Numba's runtime (``_nrt=False``), so without
-reference counts.  Every record a stage receives, and every field read from
-it, would otherwise cost an atomic reference-count change per array, each
-step: 20 to 60 of them, which made a two-agent step take more than twice as
-long as its arithmetic.  It is safe because the caller keeps every array
-alive and nothing in a step allocates; a stage that allocated would not
-compile.  For the same reason no parallel loop reduces into a variable (Numba
-allocates for that): blocks write their partial results into work space.
+* ``measure``, ``pair_pass``, ``formation_pair`` and ``LISTED`` — the agents' knowledge, exact or
+  sensed (:data:`tmem.engine.knowledge.KNOWLEDGE`);
+* ``agent_terms`` — the agent terms' pass, their pushes gathered agent by agent, the gas's walls and
+  thermostat last (:func:`tmem.engine.terms.agent_stage`);
+* ``counts_due``, ``count_pair``, ``tilt_limit``, ``after_step`` — the gas's
+  observers, or nothing (:data:`tmem.engine.gas.OBSERVERS`);
+* ``vehicle_step`` — the vehicle model's compiled step.
+
+Every copy is compiled without Numba's runtime (``_nrt=False``), so without reference counts.
+Every record a stage receives, and every field read from it, would otherwise cost an atomic
+reference-count change per array, each step: 20 to 60 of them, which made a two-agent step take
+more than twice as long as its arithmetic.  It is safe because the caller keeps every array
+alive and nothing in a step allocates; a stage that allocated would not compile.  For the same
+reason no parallel loop reduces into a variable (Numba allocates for that): blocks write their
+partial results into work space.  Inside a parallel loop, a record holding a tuple (``Run``, with
+its box) cannot be passed on, and a stage that writes into a record's arrays is called, not
+inlined: inlined, its writes were lost on threads (``tests/test_gas.py`` compares the threaded loop's
+totals with the serial one's).
 """
 
 from __future__ import annotations
 
-import types
 from functools import cache
 
 import numba
 import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from tmem.world.space import into_box
-from tmem.world.sensing import measure
 from tmem.engine.records import DONE, LISTS_STALE
-from tmem.law.modal import tilt_scale
-from tmem.engine.gas import gas_pushes, tally, tilt_limit
-from tmem.engine.pairs import formation_pairs
-from tmem.engine.sensed import sensed_formation_pairs, sensed_neighbour_pushes
-from tmem.engine.pushes import neighbour_pushes
 from tmem.engine.stages import apply_commands, commands_due, corrected_positions, is_recorded, record
-
-#: Whether the loop takes the sensed path (:mod:`tmem.engine.sensed`); bound for each compiled copy by
-#: :func:`advance_for`.  Numba prunes the branch not taken before it types the loop, so the exact
-#: copy is compiled as if the sensed stages did not exist.
-SENSED = False
-#: Whether the gas is observed (:attr:`tmem.engine.records.Gas.observe`), bound for each compiled copy
-#: in the same way: a run without the gas's options steps its agents in a loop with no branch for
-#: them (the vehicles' step took a fifth longer with the branches, on 3·10^4 agents).
-OBSERVED = False
+from tmem.engine.variants import Variant, bound
+from tmem.law.modal import tilt_scale
+from tmem.world.space import into_box
 
 
-def vehicle_step(x, body, u, i, scale, params, n_axes):
-    """Placeholder for the vehicle model's compiled step, bound by :func:`advance_for`.
-
-    Parameters
-    ----------
-    x, body, u, i, scale, params, n_axes
-        As :attr:`tmem.vehicles.base.VehicleModel.step` takes them.
-    """
-    raise NotImplementedError("the step loop is compiled by advance_for, which binds the vehicle model's step")
-
-
-def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, neighbours, commands, records, events, counters,
-                    gas, wall_params):
+def _advance_source(k_stop, run, law, params, vehicle, knowledge, agents, pairs, neighbours, commands, records, events,
+                    counters, gas, terms):  # fmt: skip
     """Advance from step ``counters.step`` to ``k_stop``; return ``DONE``, or ``LISTS_STALE`` when the
     neighbour lists must be built before the step ``counters.step`` (the caller builds them from
     ``neighbours.p_ref`` and calls again).
 
-    Each step: commands -> measurement -> P* (6) -> neighbour pushes -> formation pairs -> thermostat,
-    walls and obstacles (when the gas is observed) -> record -> saturate the set-point and step the
-    vehicles (held over ``dt``).  On the sensed path each agent measures, and pushes from what it
-    measured.  When the gas is observed, its counts are taken at the steps that are multiples of
-    ``gas.every``."""
-    listed = 1 if SENSED else 0  # the lists hold P* (6); with sensing, P (the range is one of positions)
+    Each step: commands -> measurement -> P* (6) -> neighbour pushes (8) -> formation pairs (9)-(11)
+    -> agent terms (the gas's walls and thermostat last) -> record -> saturate the set-point and step
+    the vehicles (held over ``dt``).  When the gas is observed, its counts are taken at the steps
+    ``counts_due`` names."""
     box = run.box
     n_axes = len(box)
     c_max = params.c_max
@@ -77,65 +56,72 @@ def _advance_source(k_stop, run, law, params, vehicle, sensing, agents, pairs, n
     u = agents.setpoint
     body = agents.body
     active = agents.active
-    observe = OBSERVED
-    work, limit, totals = gas.work, gas.limit, gas.totals  # parallel loops take arrays, not records
-    walls, obstacles, g_dt, dt, every = gas.walls, gas.obstacles, gas.g_dt, gas.dt, gas.every
+    block_ptr = neighbours.block_ptr
+    block_nearest2 = neighbours.block_nearest2
+    n_blocks = block_ptr.shape[0] - 1
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k
-        counting = OBSERVED and k % every == 0
+        counting = counts_due(k, gas)  # noqa: F821  (bound)
         rebuild = commands_due(k, commands, counters) and apply_commands(k, commands, agents, pairs, events, counters, gas)
-        known = x
-        if SENSED:
-            known = measure(k, x, sensing)
-        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, listed, counting)
+        known = measure(k, x, knowledge)  # noqa: F821  (bound)
+        moved2 = corrected_positions(known, agents, law, run, neighbours, gas, LISTED, counting)  # noqa: F821
         if rebuild or (run.use_lists and np.sqrt(moved2) > 0.5 * run.skin):
             for i in range(x.shape[0]):
                 for a in range(n_axes):
-                    neighbours.p_ref[i, a] = agents.corrected[i, a, listed]
+                    neighbours.p_ref[i, a] = agents.corrected[i, a, LISTED]  # noqa: F821  (bound)
             return LISTS_STALE
-        if SENSED:
-            sensed_neighbour_pushes(k, agents, neighbours, law, params, run, sensing)
-            sensed_formation_pairs(k, agents, pairs, law, params, run, events, counters, sensing)
-        else:
-            neighbour_pushes(agents, neighbours, law, params, run, gas, counting)
-            formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas, counting)
-        if OBSERVED:
-            gas_pushes(known, agents, gas, wall_params, run, neighbours.block_shift2.shape[0], counting)
+        # The neighbours' pushes: each block's own pairs on a thread, then the pairs between blocks,
+        # so that every agent adds its pushes in one order whatever the number of threads.  (A
+        # parallel loop takes records of arrays and numbers, not a record holding a tuple: the box
+        # goes on its own.)
+        for b in numba.prange(n_blocks):
+            block_nearest2[b] = np.inf
+            if block_ptr[b + 1] > block_ptr[b]:
+                block_nearest2[b] = pair_pass(k, block_ptr[b], block_ptr[b + 1], b, agents, neighbours, law, params,  # noqa: F821
+                                              box, knowledge, gas, counting)  # fmt: skip
+        nearest2 = np.inf
+        if neighbours.n_pairs > neighbours.n_inside:
+            nearest2 = pair_pass(k, neighbours.n_inside, neighbours.n_pairs, n_blocks, agents, neighbours, law, params,  # noqa: F821
+                                 box, knowledge, gas, counting)  # fmt: skip
+        for b in range(n_blocks):
+            nearest2 = min(nearest2, block_nearest2[b])
+        neighbours.closest[0] = min(neighbours.closest[0], nearest2)
+        for e in range(pairs.i.shape[0]):
+            formation_pair(k, e, known, agents, pairs, law, params, run, events, counters, knowledge)  # noqa: F821
+            count_pair(e, agents, pairs, law, params, run, gas, counting)  # noqa: F821  (bound)
+        agent_terms(k, known, agents, box, terms, gas, neighbours.block_shift2.shape[0], counting)  # noqa: F821
         if is_recorded(k, run):
-            record(agents, pairs, records, c_max, run, counters, gas, SENSED)
+            record(agents, pairs, records, c_max, run, counters, gas, LISTED == 1)  # noqa: F821  (bound)
         if k < run.n_steps:
-            sampled = min(every, run.n_steps - k) if counting else 0  # the steps this count stands for
+            sampled = min(gas.every, run.n_steps - k) if counting else 0  # the steps this count stands for
             for i in numba.prange(x.shape[0]):
                 if active[i]:
-                    scale = tilt_scale(u, i, n_axes, tilt_limit(observe, limit, i, c_max))
-                    vehicle_step(x, body, u, i, scale, vehicle, n_axes)
+                    scale = tilt_scale(u, i, n_axes, tilt_limit(i, gas, c_max))  # noqa: F821  (bound)
+                    vehicle_step(x, body, u, i, scale, vehicle, n_axes)  # noqa: F821  (bound)
                     for a in range(n_axes):
                         if box[a] > 0.0 and not 0.0 <= x[i, a, 0] < box[a]:  # inside, the floor is 0
                             x[i, a, 0] = into_box(x[i, a, 0], box[a])
-                    if observe:
-                        tally(x, i, scale, work, totals, walls, obstacles, box, g_dt, dt, n_axes, sampled)
+                    after_step(x, i, scale, gas, box, n_axes, sampled)  # noqa: F821  (bound)
     counters.step[0] = k_stop
     return DONE
 
 
 @cache
-def advance_for(model_class, threaded: bool, sensed: bool = False, observed: bool = False):
-    """The compiled loop of a vehicle model (a :class:`tmem.vehicles.base.VehicleModel` subclass).
+def advance_for(variant: Variant):
+    """The compiled loop of a variant of the step (:class:`~tmem.engine.variants.Variant`).
 
     Parameters
     ----------
-    model_class
-        Its ``step`` kernel is bound to ``vehicle_step``; its ``kind`` names the copy.
-    threaded
-        Per-agent stages and blocks of neighbour sums on threads (large swarms).
-    sensed
-        The sensed path (:mod:`tmem.engine.sensed`): a copy of its own, named ``..._sensed``.
-    observed
-        The gas observed (its stages and totals, :mod:`tmem.engine.gas`): a copy named ``..._gas``.
+    variant : Variant
+        The vehicle, the knowledge, the agent terms, the gas and the threads: their kernels are
+        bound to the names the loop calls, in a copy named :meth:`Variant.name` ``("advance")``.
     """
-    name = (f"_advance_{model_class.kind}_{'threaded' if threaded else 'serial'}{'_sensed' if sensed else ''}"
-            f"{'_gas' if observed else ''}")  # fmt: skip
-    namespace = dict(_advance_source.__globals__, vehicle_step=model_class.step, SENSED=sensed, OBSERVED=observed)
-    source = types.FunctionType(_advance_source.__code__, namespace, name)
-    source.__qualname__ = name
-    return numba.njit(cache=True, parallel=threaded, error_model="numpy", _nrt=False)(source)
+    from tmem.engine.gas import OBSERVERS
+    from tmem.engine.knowledge import KNOWLEDGE
+    from tmem.engine.terms import agent_stage
+    from tmem.vehicles import vehicle_class
+
+    names = dict(KNOWLEDGE[variant.knowledge](), **OBSERVERS[variant.gas](), vehicle_step=vehicle_class(variant.vehicle).kernel(),
+                 agent_terms=agent_stage(variant))  # fmt: skip
+    return bound(_advance_source, variant.name("advance"),
+                 {"cache": True, "parallel": variant.threaded, "error_model": "numpy", "_nrt": False}, **names)  # fmt: skip

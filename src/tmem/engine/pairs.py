@@ -1,9 +1,12 @@
-"""The formation pairs' stage: each pair's flag ``F_en`` (9), its pull or push (10)/(11), its synchronisation.
+"""The formation pairs' law: each pair's flag ``F_en`` (9), its pull or push (10)/(11), its synchronisation.
 
 A pair couples and uncouples by :mod:`tmem.law.coupling`: at the window (9), and,
 with ``interaction.uncouple_when = "energy"``, uncouples where its relative
 kinetic energy and ``f1 - f2`` match their values at coupling.  While coupled
 it may also synchronise its agents' speeds (:mod:`tmem.law.synchronise`, (S2)).
+:func:`formation_pair` is the law of one pair under exact knowledge (the step loop's, the batch's
+and the per-agent controller's); the sensed knowledge (:mod:`tmem.engine.sensed`) runs the same
+rules from each agent's own view.
 """
 
 from __future__ import annotations
@@ -15,8 +18,27 @@ from tmem.law import coupling
 from tmem.law.interaction.kernels import FunctionParams, pair_control
 from tmem.world.space import nearest_image
 from tmem.law.synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
-from tmem.engine.gas import add_contact, pair_share, virial_by_pairs
 from tmem.engine.stages import log_event
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def pair_distance2(corrected, i, j, box):
+    """``|P_j - P_i|^2`` of agents ``i`` and ``j`` (nearest images), from ``corrected``'s true positions.
+
+    Parameters
+    ----------
+    corrected : ndarray, shape (agents, axes, 2)
+        ``(P*, P)`` of each agent on each axis (:class:`tmem.engine.records.Agents`).
+    i, j : int
+        The agents.
+    box : tuple of float
+        The box sides (0: open axis).
+    """
+    dist2 = 0.0
+    for a in range(len(box)):
+        delta = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
+        dist2 += delta * delta
+    return dist2
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -25,13 +47,10 @@ def _pair_geometry(corrected, e, pairs, box, d):
     i = pairs.i[e]
     j = pairs.j[e]
     r2 = 0.0
-    dist2 = 0.0
     for a in range(len(box)):
         d[a] = nearest_image(corrected[j, a, 0] - corrected[i, a, 0], box[a])
         r2 += d[a] * d[a]
-        delta = nearest_image(corrected[j, a, 1] - corrected[i, a, 1], box[a])
-        dist2 += delta * delta
-    return np.sqrt(r2), np.sqrt(dist2)
+    return np.sqrt(r2), np.sqrt(pair_distance2(corrected, i, j, box))
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -239,59 +258,3 @@ def check_flag(k, e, r, d, known, i, j, pairs, law, params, n_axes, events, coun
     entering = r < params.reach and not pairs.r_before[e] < params.reach  # or at the first step
     pairs.r_before[e] = r
     return entering
-
-
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _count_pair(e, agents, pairs, law, params, box, gas, counting):
-    """For the gas (:mod:`tmem.engine.gas`): pair ``e``, if within reach, with no coupling flag (the
-    tracked pairs of a small swarm) is a plain neighbour, and the mean of pushes (C1) divides its push
-    too; at a count, it is counted as the neighbour stage counts its pairs.  ``pairs.d`` holds its
-    push on ``i``."""
-    i = pairs.i[e]
-    j = pairs.j[e]
-    if not (agents.active[i] and agents.active[j]) or not pairs.r_before[e] < params.reach:
-        return
-    n_axes = len(box)
-    d = pairs.d
-    size2 = 0.0
-    for a in range(n_axes):
-        size2 += d[a] * d[a]
-    pressing = size2 / (params.c_max * params.c_max)
-    if gas.mean and not law.couples:
-        share = pair_share(i, j, gas.weight)
-        if share < 1.0:
-            for a in range(n_axes):
-                agents.setpoint[i, a] -= (1.0 - share) * d[a]
-                agents.setpoint[j, a] += (1.0 - share) * d[a]
-                d[a] *= share
-    if not counting:
-        return
-    virial = 0.0
-    for a in range(n_axes):
-        virial -= nearest_image(agents.corrected[j, a, 1] - agents.corrected[i, a, 1], box[a]) * d[a]
-    add_contact(i, j, 1.0, pressing, virial, virial_by_pairs(gas.walls), gas.work, agents.state)
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def formation_pairs(k, known, agents, pairs, law, params, run, events, counters, gas, counting):
-    """Every formation pair's step, :func:`formation_pair`, in order; weighted and counted for the gas
-    when it is observed (:func:`_count_pair`).
-
-    Parameters
-    ----------
-    k : int
-        The step.
-    known : ndarray, shape (agents, axes, n_state)
-        The states as measured (:func:`tmem.world.sensing.measure`).
-    agents, pairs, law, run, events, counters, gas
-        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``pairs``, ``events``,
-        ``counters`` and ``gas`` change in place.
-    params : FunctionParams
-        The interaction functions' parameters.
-    counting : bool
-        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).
-    """
-    for e in range(pairs.i.shape[0]):
-        formation_pair(k, e, known, agents, pairs, law, params, run.box, events, counters)
-        if gas.observe:
-            _count_pair(e, agents, pairs, law, params, run.box, gas, counting)

@@ -1,8 +1,9 @@
-"""The neighbour stage: the pushes of every listed non-formation pair, summed in chunks.
+"""The neighbours' pushes under exact knowledge: every listed non-formation pair, summed in chunks.
 
-Step 4 of the loop (:mod:`tmem.engine.stages` lists them all).  Each pair ``(i, j)`` of the
+Step 4 of the loop (:mod:`tmem.engine.loop`), the exact knowledge's ``pair_pass``
+(:mod:`tmem.engine.knowledge`).  Each pair ``(i, j)`` of the
 neighbour lists (:mod:`tmem.world.neighbors`) is pushed once, equal and opposite, with the interaction
-function of :attr:`tmem.engine.records.Law.neighbour_function` along ``d / |d|``, ``d = P*_j - P*_i``
+function of :attr:`tmem.law.record.Law.neighbour_function` along ``d / |d|``, ``d = P*_j - P*_i``
 (6).  Pairs are gathered into chunks, pushed in vectorised arithmetic (:func:`_chunk_pushes`), then
 added to the set-points, weighted under the mean of pushes (C1).  At a count of the gas, the adding
 also counts each pair for the gas (:func:`_add_counted`; :mod:`tmem.engine.gas`).
@@ -44,15 +45,38 @@ def _chunk_pushes(chunks, w, m, n_axes, function, params):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _pushes_of(corrected, known, pairs, first, stop, box, function, params, u, chunks, w, gas, counting):
-    """Add to ``u`` the pushes of pairs ``first:stop``, each ``(i, j)`` once, equal and opposite, in
-    the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within reach.  ``chunks[w]`` is
-    the work space.  Under the mean of pushes (C1) each push is weighted; at a count of the gas, each
-    pair is counted for both its agents too (:func:`_add_counted`).
+def pair_pass(k, first, stop, w, agents, neighbours, law, params, box, knowledge, gas, counting):
+    """Add the pushes of the listed pairs ``first:stop`` to the set-points, each ``(i, j)`` once,
+    equal and opposite, in the order listed; return the smallest ``|P_j - P_i|^2`` of a pair within
+    reach.  The exact knowledge's ``pair_pass`` (:mod:`tmem.engine.knowledge`).
 
-    Called, not inlined: the loop calls it from two places, and each inlined copy of it (with the
-    interaction functions inside) cost two seconds of the first run's compilation.  The call costs
-    nanoseconds against the chunks of pairs it sums; the loop skips it when there are no pairs."""
+    Under the mean of pushes (C1) each push is weighted; at a count of the gas, each pair is counted
+    for both its agents too (:func:`_add_counted`).  Called, not inlined: the loop calls it from two
+    places, and each inlined copy of it (with the interaction functions inside) cost two seconds of
+    the first run's compilation.  The call costs nanoseconds against the chunks of pairs it sums.
+
+    Parameters
+    ----------
+    k : int
+        The step (unused: exact knowledge does not age).
+    first, stop : int
+        The listed pairs ``neighbours.pairs[first:stop]``.
+    w : int
+        The row of ``neighbours.chunks`` this call works in (its block's).
+    agents, neighbours, law, gas
+        The loop's records (:mod:`tmem.engine.records`); ``agents.setpoint`` and the gas's counts
+        change in place.
+    params : FunctionParams
+        The interaction functions' parameters.
+    box : tuple of float
+        The periodic box's sides (0: open axis).
+    knowledge : Sensing
+        Unused: every agent knows every state.
+    counting : bool
+        Whether the step is a count of the gas.
+    """
+    corrected, known, u = agents.corrected, agents.state, agents.setpoint  # the gas's stages need exact knowledge
+    pairs, chunks, function = neighbours.pairs, neighbours.chunks, law.neighbour_function
     n_axes = len(box)
     nearest2 = np.inf
     for begin in range(first, stop, CHUNK):
@@ -115,46 +139,3 @@ def _add_counted(chunks, w, m, pairs, begin, n_axes, u, gas, known):
                 virial -= chunks[w, n_axes + a, t] * push
         add_contact(i, j, 1.0 if chunks[w, 2 * n_axes, t] < np.inf else 0.0, size2 * inv_c_max2, virial, pair_virial,
                     work, known)  # fmt: skip
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def neighbour_pushes(agents, neighbours, law, params, run, gas, counting):
-    """Sum the pushes of every listed non-formation pair within reach, ``f(|d|)`` along ``d / |d|``.
-
-    (Parallel loops take plain arrays and numbers: the records' fields are read out before them.)
-    Each block's own pairs run on a thread of their own, then the pairs crossing between blocks, so
-    every agent adds its pushes in one order whatever the number of threads.  ``f`` is the
-    function of :attr:`Law.neighbour_function`, with the scenario's ``d_t``.
-
-    Parameters
-    ----------
-    agents, neighbours, law, run, gas
-        The loop's records (:mod:`tmem.engine.records`); ``agents``, ``neighbours`` and ``gas`` change
-        in place.
-    params : tmem.law.interaction.kernels.FunctionParams
-        The interaction functions' parameters.
-    counting : bool
-        Whether the step is a count of the gas (:attr:`tmem.engine.records.Gas.every`).
-    """
-    box = run.box
-    function = law.neighbour_function
-    corrected = agents.corrected
-    known = agents.state  # the gas's stages run only where sensing is exact
-    setpoint = agents.setpoint
-    pairs = neighbours.pairs
-    block_ptr = neighbours.block_ptr
-    block_nearest2 = neighbours.block_nearest2
-    chunks = neighbours.chunks
-    n_blocks = block_ptr.shape[0] - 1
-    for b in numba.prange(n_blocks):
-        block_nearest2[b] = np.inf
-        if block_ptr[b + 1] > block_ptr[b]:
-            block_nearest2[b] = _pushes_of(corrected, known, pairs, block_ptr[b], block_ptr[b + 1], box, function,
-                                           params, setpoint, chunks, b, gas, counting)  # fmt: skip
-    nearest2 = np.inf
-    if neighbours.n_pairs > neighbours.n_inside:
-        nearest2 = _pushes_of(corrected, known, pairs, neighbours.n_inside, neighbours.n_pairs, box, function, params,
-                              setpoint, chunks, n_blocks, gas, counting)  # fmt: skip
-    for b in range(n_blocks):
-        nearest2 = min(nearest2, block_nearest2[b])
-    neighbours.closest[0] = min(neighbours.closest[0], nearest2)

@@ -23,52 +23,6 @@ UNCOUPLE, COUPLE, REMOVE, ADD, TEMPERATURE = range(5)
 DONE, LISTS_STALE = 0, -1
 
 
-class Law(NamedTuple):
-    """The TMEM controller of every agent: (6)-(11) and the saturation.
-
-    Attributes
-    ----------
-    gains : ndarray, shape (agents, 4) or (1, 4)
-        Each agent's ``K = (K_P, K_V, K_phi, K_omega)``, in slot order; ``P* = x . K / K_P`` (6)
-        with the agent's own gains.  One row is every agent's: a scenario gives all agents the same.
-    function : int
-        Registry code of the scenario's function, used by the formation pairs.
-    neighbour_function : int
-        Registry code of the function other neighbours use: the scenario's own
-        if it has no flag, else the repulsion (8).
-    couples : bool
-        Whether the function switches on ``F_en``.
-    at_crossing : bool
-        ``interaction.switch_at == "crossing"`` (:func:`tmem.law.coupling.next_flag`).
-    eps : float
-        The coupling window of (9) (m).
-    uncouple_rule : int
-        Code of ``interaction.uncouple_when`` (:data:`tmem.law.coupling.UNCOUPLE_RULES`).
-    energy_tolerance : float
-        The relative tolerance of the energy-matched uncoupling.
-    fallback_steps : int
-        Steps after an uncouple command when the energy-matched uncoupling falls back on (9).
-    sync_gain : float
-        ``k_s`` of the speed synchronisation (S2) (rad per m/s); 0: none.
-
-    The interaction functions' parameters travel beside it, as their own
-    record (:class:`~tmem.law.interaction.kernels.FunctionParams`: the law's ``K_P``,
-    ``R + R_j``, the scenario's ``d_t`` and ``c_max``): a parallel loop takes a
-    record only as an argument of the function it runs in, not as a field.
-    """
-
-    gains: np.ndarray
-    function: int
-    neighbour_function: int
-    couples: bool
-    at_crossing: bool
-    eps: float
-    uncouple_rule: int
-    energy_tolerance: float
-    fallback_steps: int
-    sync_gain: float
-
-
 class Run(NamedTuple):
     """What stays fixed over a run.
 
@@ -265,6 +219,8 @@ class Gas(NamedTuple):
         Centre and radius of each circle (sphere in 3-D).
     wall_reach : float
         ``R + R_w`` (m): a wall or obstacle pushes an agent whose ``P*`` is closer to it than that.
+    k_p : float
+        ``K_P``: a wall's or obstacle's repulsion (8) is the law's, with ``R + R_w`` for its reach.
     c_max : float
         The scenario's tilt limit (rad).
     first : ndarray, shape (1,), bool
@@ -301,6 +257,7 @@ class Gas(NamedTuple):
     walls: np.ndarray
     obstacles: np.ndarray
     wall_reach: float
+    k_p: float
     c_max: float
     first: np.ndarray
     work: np.ndarray

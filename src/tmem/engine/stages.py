@@ -1,26 +1,15 @@
-"""The compiled stages of one step, each one idea, in the order the loop runs them.
+"""The stages of one step that every variant shares: commands, ``P*`` (6) and the record.
 
-Every stage is a Numba function inlined into the loop (:mod:`tmem.engine.loop`)
-except the carrying out of commands, which is rare, and works on the records
-of :mod:`tmem.engine.records` in place.  Nothing is allocated at a step: the
-work space comes in the records.
+Every stage is a Numba function inlined into the loop (:mod:`tmem.engine.loop`) except the
+carrying out of commands, which is rare, and works on the records of :mod:`tmem.engine.records`
+in place.  Nothing is allocated at a step: the work space comes in the records.
 
-1. :func:`apply_commands` — operator commands due at the step (:func:`commands_due`);
-2. measurement (:func:`tmem.world.sensing.measure`) — the states as each agent knows them (the
-   sensed path, :mod:`tmem.engine.sensed`, takes the place of steps 4 and 5);
-3. :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the
-   lists have drifted;
-4. :func:`tmem.engine.pushes.neighbour_pushes` — the pushes of the non-formation neighbours;
-5. :func:`tmem.engine.pairs.formation_pairs` — each pair's flag ``F_en`` and its pull or push;
-   then, when the gas is observed, :func:`tmem.engine.gas.gas_pushes` — walls, obstacles and the
-   thermostat (the gas's counts are taken every ``Gas.every`` steps, in steps 3 to 5);
-6. :func:`record` — the recorded step;
-7. combining and saturating the set-point (:func:`tmem.law.modal.tilt_scale`) and the
-   vehicle's step, in the loop itself (the vehicle model's kernel is bound there).
+* :func:`apply_commands` — operator commands due at the step (:func:`commands_due`);
+* :func:`corrected_positions` — ``P*`` (6) of every agent, and how far the lists have drifted;
+* :func:`record` — the recorded step, with the set-points as the vehicles take them.
 
-Steps 5 and 6 of the agents' update share one pass: the factor that saturates
-the summed set-point on its norm is computed where it is used, which saves a
-pass over every agent.
+The stages that vary between runs are the knowledge's (:mod:`tmem.engine.knowledge`), the agent
+terms' (:mod:`tmem.engine.terms`), the gas's observers (:mod:`tmem.engine.gas`) and the vehicle's.
 """
 
 from __future__ import annotations
@@ -30,9 +19,9 @@ import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law import coupling
-from tmem.law.modal import corrected_by, gains_of, tilt_scale
+from tmem.law.modal import corrected_position, gains_row, tilt_scale
 from tmem.world.space import nearest_image
-from tmem.engine.gas import clear, record_totals, tilt_limit
+from tmem.engine.gas import clear, limit_of, record_totals
 from tmem.engine.records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
 
 @numba.njit(cache=True, inline="always")
@@ -194,15 +183,13 @@ def corrected_positions(known, agents, law, run, neighbours, gas, listed, counti
     n_agents = known.shape[0]
     n_blocks = block_shift2.shape[0]
     per_block = (n_agents + n_blocks - 1) // n_blocks
-    per_agent = gains.shape[0] > 1
-    shared = gains_of(gains, 0)
     for b in numba.prange(n_blocks):  # each block's largest shift: a parallel reduction would allocate
         largest = 0.0
         for i in range(b * per_block, min(n_agents, (b + 1) * per_block)):
-            k = gains_of(gains, i) if per_agent else shared
+            row = gains_row(gains, i)
             shift2 = 0.0
             for a in range(n_axes):
-                star = corrected_by(known[i, a, 0], known[i, a, 1], known[i, a, 2], known[i, a, 3], k)
+                star = corrected_position(known, i, a, gains, row)
                 position = known[i, a, 0] if listed == 0 else state[i, a, 0]  # exact path: known is the state
                 corrected[i, a, 0] = star
                 corrected[i, a, 1] = position
@@ -259,7 +246,7 @@ def record(agents, pairs, records, c_max, run, counters, gas, sensed):
         for m in range(agents.body.shape[1]):
             records.body[q_record, q, m] = agents.body[i, m]
         records.active[q_record, q] = agents.active[i]
-        scale = tilt_scale(agents.setpoint, i, n_axes, tilt_limit(gas.observe, gas.limit, i, c_max)) if agents.active[i] else 0.0
+        scale = tilt_scale(agents.setpoint, i, n_axes, limit_of(i, gas, c_max)) if agents.active[i] else 0.0
         for a in range(n_axes):
             records.control[q_record, q, a] = agents.setpoint[i, a] * scale
     for e in range(pairs.i.shape[0]):

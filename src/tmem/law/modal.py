@@ -150,65 +150,60 @@ def interaction_point(x: np.ndarray, gains: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    x : ndarray, shape (..., 4)
-        States ``(P, V, phi, omega)``.
-    gains : ndarray, shape (4,)
-        ``K`` from :func:`modal_gains`; ``K_P = gains[0]`` is the paper's ``K1``.
+    x : ndarray, shape (..., n_state)
+        States, the law's components first (``(P, V, phi, omega)`` for a tilting multirotor).
+    gains : ndarray, shape (n_law,)
+        ``K`` from :func:`modal_gains`; ``K_P = gains[0]`` is the paper's ``K1``.  The law reads the
+        first ``n_law`` components of the state.
     """
-    return x @ (gains / gains[0])
+    return x[..., : len(gains)] @ (gains / gains[0])
 
 
 @numba.njit(cache=True, inline="always")
-def gains_of(gains, agent):
-    """Agent ``agent``'s ``K = (K_P, K_V, K_phi, K_omega)`` as four numbers, from its own row or the shared one.
-
-    A loop over agents that share one row takes it once, before the loop, and keeps it in registers.
+def gains_row(gains, agent):
+    """The row of ``gains`` that holds agent ``agent``'s ``K``: its own, or the one every agent shares.
 
     Parameters
     ----------
-    gains : ndarray, shape (agents, 4) or (1, 4)
+    gains : ndarray, shape (agents, n_law) or (1, n_law)
         Each agent's ``K`` (:func:`modal_gains`), or one row that every agent shares (no stream of
-        identical rows through the cache); indexed in place, since a row taken out as an array would
-        cost a reference count at every agent.
+        identical rows through the cache).
     agent : int
         The agent's row when there is a row per agent.
     """
-    row = agent if gains.shape[0] > 1 else 0
-    return gains[row, 0], gains[row, 1], gains[row, 2], gains[row, 3]
+    return agent if gains.shape[0] > 1 else 0
 
 
 @numba.njit(cache=True, inline="always")
-def corrected_by(p, v, phi, omega, k):
-    """``P* = x . K / K_P`` (6) of one axis's state ``x = (p, v, phi, omega)``, in compiled code.
+def corrected_position(x, i, a, gains, row):
+    """``P* = x . K / K_P`` (6) of row ``i``'s state on axis ``a``, in compiled code.
 
     The same quantity as :func:`interaction_point`, for the step loop, the batch and the per-agent
-    controller; the sum runs in the order of the state, so every caller gets the same bits.
+    controller.  The sum runs over the components the law reads (as many as ``K`` has: a vehicle
+    may keep more after them), in the order of the state, so every caller gets the same bits.
 
     Parameters
     ----------
-    p, v, phi, omega : float
-        Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
-    k : tuple of 4 float
-        The agent's ``K`` (:func:`gains_of`).
-    """
-    return (p * k[0] + v * k[1] + phi * k[2] + omega * k[3]) / k[0]
-
-
-@numba.njit(cache=True, inline="always")
-def corrected_position(p, v, phi, omega, gains, agent):
-    """``P* = x . K / K_P`` (6) of one axis's state of agent ``agent``: :func:`corrected_by` with
-    :func:`gains_of`.
-
-    Parameters
-    ----------
-    p, v, phi, omega : float
-        Position (m), velocity (m/s), tilt (rad) and tilt rate (rad/s).
-    gains : ndarray, shape (agents, 4) or (1, 4)
+    x : ndarray, shape (rows, axes, n_state)
+        States, the law's components first (``(P, V, phi, omega)`` for a tilting multirotor).
+    i, a : int
+        The row and the axis.
+    gains : ndarray, shape (agents, n_law) or (1, n_law)
         Each agent's ``K``, or one row that every agent shares.
-    agent : int
-        The agent's row when there is a row per agent.
+    row : int
+        The row of ``gains`` to use (:func:`gains_row`).
+
+    Four components, a tilting multirotor's, are summed written out: the paper's batch of
+    encounters (:mod:`tmem.batch.relative`) is compiled with fused multiply-adds, and the sum
+    written out fuses there as it always has, so its results keep their bits.
     """
-    return corrected_by(p, v, phi, omega, gains_of(gains, agent))
+    if gains.shape[1] == 4:
+        return (x[i, a, 0] * gains[row, 0] + x[i, a, 1] * gains[row, 1] + x[i, a, 2] * gains[row, 2]
+                + x[i, a, 3] * gains[row, 3]) / gains[row, 0]  # fmt: skip
+    total = x[i, a, 0] * gains[row, 0]
+    for m in range(1, gains.shape[1]):
+        total += x[i, a, m] * gains[row, m]
+    return total / gains[row, 0]
 
 
 @numba.njit(cache=True, inline="always")

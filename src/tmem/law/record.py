@@ -1,4 +1,4 @@
-"""The TMEM controller of a run as the step loop's :class:`~tmem.engine.records.Law` record.
+"""The TMEM controller of a run as the step loop's :class:`~tmem.law.record.Law` record.
 
 The ``[interaction]`` table names the law: the interaction function (8), (10) or (11) and the
 function the other neighbours push with, where the flag ``F_en`` flips and how a pair uncouples
@@ -9,6 +9,8 @@ both run the same law.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from tmem.law import coupling
@@ -16,7 +18,52 @@ from tmem.law.interaction.kernels import FunctionParams
 from tmem.law.interaction.registry import code, uses_coupling
 from tmem.scenario import Scenario
 from tmem.law.synchronise import coupled_mode, synchronising_gain
-from tmem.engine.records import Law
+
+
+class Law(NamedTuple):
+    """The TMEM controller of every agent: (6)-(11) and the saturation.
+
+    Attributes
+    ----------
+    gains : ndarray, shape (agents, 4) or (1, 4)
+        Each agent's ``K = (K_P, K_V, K_phi, K_omega)``, in slot order; ``P* = x . K / K_P`` (6)
+        with the agent's own gains.  One row is every agent's: a scenario gives all agents the same.
+    function : int
+        Registry code of the scenario's function, used by the formation pairs.
+    neighbour_function : int
+        Registry code of the function other neighbours use: the scenario's own
+        if it has no flag, else the repulsion (8).
+    couples : bool
+        Whether the function switches on ``F_en``.
+    at_crossing : bool
+        ``interaction.switch_at == "crossing"`` (:func:`tmem.law.coupling.next_flag`).
+    eps : float
+        The coupling window of (9) (m).
+    uncouple_rule : int
+        Code of ``interaction.uncouple_when`` (:data:`tmem.law.coupling.UNCOUPLE_RULES`).
+    energy_tolerance : float
+        The relative tolerance of the energy-matched uncoupling.
+    fallback_steps : int
+        Steps after an uncouple command when the energy-matched uncoupling falls back on (9).
+    sync_gain : float
+        ``k_s`` of the speed synchronisation (S2) (rad per m/s); 0: none.
+
+    The interaction functions' parameters travel beside it, as their own
+    record (:class:`~tmem.law.interaction.kernels.FunctionParams`: the law's ``K_P``,
+    ``R + R_j``, the scenario's ``d_t`` and ``c_max``): a parallel loop takes a
+    record only as an argument of the function it runs in, not as a field.
+    """
+
+    gains: np.ndarray
+    function: int
+    neighbour_function: int
+    couples: bool
+    at_crossing: bool
+    eps: float
+    uncouple_rule: int
+    energy_tolerance: float
+    fallback_steps: int
+    sync_gain: float
 
 
 def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gains: np.ndarray) -> tuple[Law, FunctionParams]:
@@ -49,7 +96,7 @@ def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gai
 
 def law_record(gains: np.ndarray, function: str, switch_at: str, eps: float, uncouple_when: str, energy_tolerance: float,
                fallback_steps: int, sync_gain: float) -> Law:  # fmt: skip
-    """The :class:`~tmem.engine.records.Law` of agents that share the gains ``gains``, from the names
+    """The :class:`~tmem.law.record.Law` of agents that share the gains ``gains``, from the names
     and numbers of an ``[interaction]`` table.
 
     Parameters

@@ -18,9 +18,10 @@ import math
 import unicodedata
 
 import numpy as np
-from pydantic import field_validator, model_validator
+from pydantic import create_model, field_validator, model_validator
 
 from tmem.analysis.coverage import MAX_CELLS
+from tmem.terms import TERMS, term_class
 from tmem.world.formation import generate
 from tmem.law.interaction.registry import uses_coupling
 from tmem.scenario.agents_table import Agent, SwarmParams, check_agents
@@ -58,7 +59,7 @@ MAX_NAME_LENGTH = 200
 MAX_ROOT_DT = 0.15
 #: Smallest position gain K_P: below it the gains (4) lose their precision and soon underflow to 0.
 MIN_K_P = 1e-150
-class Scenario(StrictModel):
+class _Scenario(StrictModel):
     """A whole scenario; see the module docstring.
 
     The agents come from exactly one of ``[[agents]]`` (Table 2),
@@ -116,6 +117,17 @@ class Scenario(StrictModel):
         """Side of the coverage map's cells (m): ``coverage.cell``, default ``R``."""
         cell = self.coverage.cell if self.coverage is not None else None
         return self.interaction.radius if cell is None else cell
+
+    @property
+    def agent_terms(self) -> tuple[str, ...]:
+        """The agent terms the scenario gives (their tables' names, in the order of :data:`tmem.terms.TERMS`)."""
+        return tuple(name for name in TERMS if getattr(self, name) is not None)
+
+    @property
+    def position_gain(self) -> float:
+        """``K_P`` of the law (rad/m): the modal gain on position that places the roots (5) (:func:`tmem.law.modal.modal_gains`)."""
+        c, model = self.controller, self.model
+        return (c.r_l**2 + c.im_l**2) * c.im_r**2 / (model.g * model.kp * model.kd)
 
     @property
     def gas_observed(self) -> bool:
@@ -193,6 +205,10 @@ class Scenario(StrictModel):
                 "simulation.record_agents", "is empty and there are no pairs to record: the run would record nothing"
             )
         check_commands(self, n, pairs)
+        for name in self.agent_terms:
+            table = getattr(self, name)
+            if hasattr(table, "check"):
+                table.check(self)
         check_record_size(self, n, len(pairs))
         self._check_formation_room(axes, n)
         return self
@@ -275,9 +291,9 @@ class Scenario(StrictModel):
 
     def _check_sampling(self) -> None:
         """The gains must not underflow, and dt must resolve the closed loop A - B K (roots (5))."""
-        c, model, dt = self.controller, self.model, self.simulation.dt
+        c, dt = self.controller, self.simulation.dt
         left = c.r_l**2 + c.im_l**2
-        k_p = left * c.im_r**2 / (model.g * model.kp * model.kd)
+        k_p = self.position_gain
         if not k_p >= MIN_K_P:
             field, value = ("controller.im_r", c.im_r) if c.im_r**2 < left else ("controller.r_l", c.r_l)
             raise FieldError(
@@ -314,3 +330,10 @@ class Scenario(StrictModel):
         from tmem.scenario.files import _to_toml  # the writer lives with the reader
 
         return _to_toml(self.model_dump(mode="json", exclude_none=True))
+
+
+#: The whole scenario: the tables above, and one optional table per agent term (:data:`tmem.terms.TERMS`).
+Scenario = create_model(
+    "Scenario", __base__=_Scenario, __module__=__name__, __doc__=_Scenario.__doc__,
+    **{name: (term_class(name).table | None, None) for name in TERMS},
+)  # fmt: skip

@@ -19,6 +19,18 @@ MODELS: dict[str, str] = {
 }
 
 
+def vehicle_class(kind: str):
+    """The :class:`~tmem.vehicles.base.VehicleModel` subclass of the ``[model] kind`` ``kind``.
+
+    Parameters
+    ----------
+    kind : str
+        A key of :data:`MODELS`.
+    """
+    module, name = MODELS[kind].split(":")
+    return getattr(import_module(module), name)
+
+
 def vehicle_model(params: Any, wind: Any = None):
     """The :class:`~tmem.vehicles.base.VehicleModel` for a scenario's ``[model]`` table (by its ``kind``).
 
@@ -30,6 +42,5 @@ def vehicle_model(params: Any, wind: Any = None):
         The scenario's ``[wind]`` table, for a model that feels it (the quadrotor's: the schema
         refuses it with another); default: none.
     """
-    module, name = MODELS[params.kind].split(":")
-    model_class = getattr(import_module(module), name)
+    model_class = vehicle_class(params.kind)
     return model_class(params) if wind is None else model_class(params, wind)

@@ -70,6 +70,11 @@ class VehicleModel(ABC):
     def __init__(self, params: Any):
         self.params = params
 
+    @classmethod
+    def kernel(cls) -> Any:
+        """The compiled step the loop binds to ``vehicle_step`` (:mod:`tmem.engine.loop`)."""
+        return cls.step
+
     @abstractmethod
     def linearisation(self) -> tuple[np.ndarray, np.ndarray]:
         """``(A, B)`` about hover on ``(P, V, phi, omega)`` per axis: shapes (4, 4) and (4,)."""

@@ -23,7 +23,7 @@ own measurement; the model, in ``docs/sensing.md``:
   older than the largest delay; then the neighbour is no longer measured.
 * **Noise.**  A received message's position and velocity carry Gaussian
   noise, drawn once per message and receiver (a held message keeps its
-  noise): :func:`known_axis`.  An agent's own state carries noise of
+  noise): :func:`known_state`.  An agent's own state carries noise of
   its own, drawn once a period and held over it (:func:`measure`).
 * **Range.**  A neighbour farther than ``range`` (true distance now) is not
   measured at all.
@@ -35,7 +35,7 @@ Every draw is a hash of ``(seed, receiver, sender, step, draw)``
 threads, on the kind of neighbour list, or on the order of pairs.
 
 A new effect is a parameter in :class:`Sensing` (with a value that turns it
-off) and a line in :func:`known_axis`, or in :func:`measure` for an agent's
+off) and a line in :func:`known_state`, or in :func:`measure` for an agent's
 own state (``docs/architecture.md`` walks through one).
 """
 
@@ -47,7 +47,6 @@ import numba
 import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
-from tmem.law.modal import corrected_position
 from tmem.scenario.sensing_table import LAG_TOLERANCE, SensingParams, lag
 from tmem.world.streams import message_key, normal_pair, uniform
 
@@ -90,6 +89,8 @@ class Sensing(NamedTuple):
         Work space: each agent's own state as it measures it this step.
     pair_states : ndarray, shape (2, axes, n_state)
         Work space: a formation pair's two states as one of its agents knows them.
+    seen : ndarray, shape (blocks + 1, axes, n_state)
+        Work space: the state of a sender as its receiver knows it, in each block of the neighbour sums.
     pushes : ndarray, shape (2, axes)
         Work space: a pair's synchronising pushes as one of its agents computes them.
     work : ndarray, shape (blocks + 1, axes)
@@ -113,6 +114,7 @@ class Sensing(NamedTuple):
     history: np.ndarray
     own: np.ndarray
     pair_states: np.ndarray
+    seen: np.ndarray
     pushes: np.ndarray
     work: np.ndarray
 
@@ -152,6 +154,7 @@ def sensing_of(settings: SensingParams, order: np.ndarray, shape: tuple, dt: flo
         history=np.zeros((settings.depth(dt),) + tuple(shape)),
         own=np.empty(shape),
         pair_states=np.empty((2,) + tuple(shape[1:])),
+        seen=np.empty((n_blocks + 1,) + tuple(shape[1:])),
         pushes=np.empty((2, shape[1])),
         work=np.empty((n_blocks + 1, shape[1])),
     )
@@ -226,8 +229,9 @@ def latest_message(k, i, j, sensing):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def known_axis(state, sensing, key, j, s, a):
-    """``(P, V, phi, omega)`` of ``j`` on axis ``a`` as its receiver knows it from ``j``'s message ``s``.
+def known_state(state, sensing, key, j, s, out, row):
+    """The state of ``j`` as its receiver knows it from ``j``'s message ``s``, into ``out[row]``: every
+    component as sent, and the noise on position and velocity, per axis.
 
     Parameters
     ----------
@@ -241,35 +245,19 @@ def known_axis(state, sensing, key, j, s, a):
         Slot of the sender.
     s : int
         The message (the step it was sent; :func:`latest_message`).
-    a : int
-        The axis.
+    out : ndarray, shape (rows, axes, n_state)
+        Work space; row ``row`` is written.
+    row : int
     """
     depth = sensing.history.shape[0]
-    if depth == 0:
-        p, v, phi, omega = state[j, a, 0], state[j, a, 1], state[j, a, 2], state[j, a, 3]
-    else:
-        history, row = sensing.history, s % depth
-        p, v, phi, omega = history[row, j, a, 0], history[row, j, a, 1], history[row, j, a, 2], history[row, j, a, 3]
-    if sensing.position_noise > 0.0 or sensing.velocity_noise > 0.0:
-        noise_p, noise_v = normal_pair(key, NOISE + a)
-        p += sensing.position_noise * noise_p
-        v += sensing.velocity_noise * noise_v
-    return p, v, phi, omega
-
-
-@numba.njit(cache=True, inline="always")
-def known_corrected(state, sensing, gains, key, j, s, a):
-    """``P*`` (6) of ``j`` on axis ``a`` as its receiver knows it from message ``s`` (with ``j``'s gains).
-
-    Parameters
-    ----------
-    state, sensing, key, j, s, a
-        As :func:`known_axis` takes them.
-    gains : ndarray, shape (agents, 4) or (1, 4)
-        Each agent's ``K`` (:class:`tmem.engine.records.Law`).
-    """
-    p, v, phi, omega = known_axis(state, sensing, key, j, s, a)
-    return corrected_position(p, v, phi, omega, gains, j)
+    noisy = sensing.position_noise > 0.0 or sensing.velocity_noise > 0.0
+    for a in range(state.shape[1]):
+        for m in range(state.shape[2]):
+            out[row, a, m] = state[j, a, m] if depth == 0 else sensing.history[s % depth, j, a, m]
+        if noisy:
+            noise_p, noise_v = normal_pair(key, NOISE + a)
+            out[row, a, 0] += sensing.position_noise * noise_p
+            out[row, a, 1] += sensing.velocity_noise * noise_v
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")

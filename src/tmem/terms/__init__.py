@@ -1,0 +1,34 @@
+"""Agent terms: pushes each agent adds for itself after the TMEM law's pair terms, ``u[i] += term(i, ...)``.
+
+A term is one class (:class:`tmem.terms.base.AgentTerm`): its scenario table, its record and its
+compiled kernel; :data:`TERMS` is the registry, ``table name -> "module:Class"``.  The scenario
+gets one optional table per row (:mod:`tmem.scenario.schema`), the driver builds each given term's
+record, the step loop adds the terms' pushes agent by agent in the order of :data:`TERMS`
+(:mod:`tmem.engine.terms`), and checkpoints save their records; none of them names a term.  The
+modules here import no compiler: a term's kernel is compiled when a run binds it.
+
+* :mod:`tmem.terms.pull` — a pull of every agent towards a point, the worked example of a term.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from importlib import import_module
+
+#: The agent terms, ``scenario table -> "module:Class"``, in the order their pushes are added.
+TERMS: dict[str, str] = {
+    "pull": "tmem.terms.pull:Pull",
+}
+
+
+@cache
+def term_class(name: str):
+    """The :class:`~tmem.terms.base.AgentTerm` registered for the scenario table ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`TERMS`.
+    """
+    module, cls = TERMS[name].split(":")
+    return getattr(import_module(module), cls)
