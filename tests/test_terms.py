@@ -95,3 +95,27 @@ def test_the_slow_pair_of_a_pulled_agent_stays_on_the_axis_up_to_k_p_and_grows_a
     slow = sorted(np.roots(np.poly(a - share * np.outer(b, k))), key=abs)[:2]
     growth = max(root.real for root in slow)
     assert low <= abs(growth) < high if share <= 1.0 else low <= growth < high
+
+
+def test_a_pulled_run_goes_on_from_its_checkpoint_to_the_same_bits(tmp_path):
+    from test_checkpoint import assert_same_bits, stopped_after
+
+    from tmem.engine.checkpoint import Checkpoints
+
+    scenario = with_changes(tmem.loads(SCENARIO.format(gain=1e-4)), {"simulation.duration": 6.0})
+    reference = tmem.simulate(scenario)
+    saved = stopped_after(scenario, tmp_path / "run.npz", 2.0, 4.0)
+    assert not [key for key in saved.arrays if key.startswith("terms.")]  # (P1)'s record is fixed for the run
+    resumed = tmem.simulate(scenario, checkpoints=Checkpoints(tmp_path / "run.npz", 2.0))
+    assert_same_bits(reference, resumed)
+
+
+def test_the_batch_and_the_per_agent_controllers_refuse_an_agent_term_in_one_line():
+    from tmem.agent import ControllerError, controllers_for
+    from tmem.batch import unsupported
+
+    scenario = tmem.loads(SCENARIO.format(gain=1e-4))
+    assert unsupported(scenario) == "the agent terms ([pull]) are the step loop's"
+    assert unsupported(with_changes(scenario, {"pull": None})) is None
+    with pytest.raises(ControllerError, match=r"^pull: is an agent term of the engine's step loop"):
+        controllers_for(scenario)

@@ -60,6 +60,8 @@ def _refusal(scenario: Scenario) -> tuple[str, str] | None:
         if given:
             reason = "per-agent controllers fly in open space" if field == "space.periodic" else gas
             return field, reason
+    for name in scenario.agent_terms:
+        return name, "is an agent term of the engine's step loop, which a per-agent controller does not run"
     for k, agent in enumerate(scenario.agents):
         if not agent.active:
             return f"agents[{k}].active", "every agent flies from the start under per-agent controllers"

@@ -239,6 +239,8 @@ def unsupported(scenario: Scenario) -> str | None:
         return "needs open space: free flight is skipped in closed form, without walls, obstacles or a box to wrap in"
     if scenario.gas_observed:
         return "the gas's options (thermostat, mean of pushes, observed totals) are the step loop's"
+    if scenario.agent_terms:
+        return f"the agent terms ({', '.join(f'[{name}]' for name in scenario.agent_terms)}) are the step loop's"
     if scenario.sensing is not None and not scenario.sensing.exact:
         return "the agents measure each other exactly: sensing effects ([sensing]) are the step loop's"
     if len(scenario.commands) > 1 or any(c.action != "uncouple" for c in scenario.commands):
