@@ -26,7 +26,7 @@ from tmem.cli.main import app
 from tmem.engine import checkpoint as ckpt
 from tmem.engine import records
 from tmem.engine.checkpoint import CheckpointError, Checkpoints, checkpoint_path
-from tmem.engine.gas_columns import COMMON
+from tmem.engine.gas_counts import COMMON
 from tmem.vehicles.quadrotor import BODY_NAMES
 from tmem.scenario import from_dict, with_changes
 

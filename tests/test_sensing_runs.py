@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 import tmem
 from tmem.cli.main import app
-from tmem.engine import driver
+from tmem.engine import driver, lists
 from tmem.scenario import from_dict, with_changes
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sensing"
@@ -35,7 +35,7 @@ def swarm(method: str, sensing: dict | None, n: int = 200, steps: int = 300) -> 
 def test_lists_and_all_pairs_give_the_same_bits(monkeypatch):
     """Noise, random delays, loss and a range: the Verlet lists (over positions, rebuilt on the way)
     and every pair give the same bits, with small blocks so that many pairs cross between them."""
-    monkeypatch.setattr(driver, "BLOCK", 64)
+    monkeypatch.setattr(lists, "BLOCK", 64)
     every = tmem.simulate(swarm("all", EVERYTHING))
     listed = tmem.simulate(swarm("verlet", EVERYTHING))
     assert listed.list_builds > 1
@@ -46,7 +46,7 @@ def test_lists_and_all_pairs_give_the_same_bits(monkeypatch):
 
 
 def test_one_thread_two_threads_and_the_serial_loop_give_the_same_bits(monkeypatch):
-    monkeypatch.setattr(driver, "BLOCK", 32)  # several blocks, summed on threads, and pairs between them
+    monkeypatch.setattr(lists, "BLOCK", 32)  # several blocks, summed on threads, and pairs between them
     monkeypatch.setattr(driver, "THREADED_SWARM", 100)
     scenario = swarm("verlet", EVERYTHING)
     threads = numba.get_num_threads()

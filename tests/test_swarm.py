@@ -5,7 +5,8 @@ import pytest
 
 import tmem
 from tmem.engine import driver as engine
-from tmem.engine.driver import _partners
+from tmem.engine import lists
+from tmem.engine.lists import _partners
 from tmem.analysis.metrics import summarize
 from tmem.world.neighbors import arrange, verlet_pairs
 from tmem.scenario import from_dict, with_changes
@@ -68,7 +69,7 @@ def test_verlet_lists_give_the_same_bits_as_all_pairs(axes, periodic):
 
 
 def test_threaded_loop_gives_the_same_bits_as_the_serial_one(monkeypatch):
-    monkeypatch.setattr(engine, "BLOCK", 32)  # several blocks, summed on both threads
+    monkeypatch.setattr(lists, "BLOCK", 32)  # several blocks, summed on both threads
     monkeypatch.setattr(engine, "THREADED_SWARM", 100)
     scenario = random_swarm(200, 2, True, "verlet")
     threaded = tmem.simulate(scenario)
@@ -81,11 +82,11 @@ def test_threaded_loop_gives_the_same_bits_as_the_serial_one(monkeypatch):
 def test_blocks_keep_verlet_lists_and_all_pairs_equal(monkeypatch, axes):
     """With small blocks many pairs cross between blocks; every agent's sum must still be the same
     with either kind of list, and close to the one-block sum (another order of the same terms)."""
-    monkeypatch.setattr(engine, "BLOCK", 64)
+    monkeypatch.setattr(lists, "BLOCK", 64)
     a = tmem.simulate(random_swarm(500, axes, True, "all", steps=100))
     b = tmem.simulate(random_swarm(500, axes, True, "verlet", steps=100))
     assert a.final_state.tobytes() == b.final_state.tobytes()
-    monkeypatch.setattr(engine, "BLOCK", 4096)
+    monkeypatch.setattr(lists, "BLOCK", 4096)
     one = tmem.simulate(random_swarm(500, axes, True, "verlet", steps=100))
     assert one.final_state.tobytes() != b.final_state.tobytes()  # the order did change
     # the tolerance allowed for another summation order; measured after 100 steps: 3.4e-15 at most

@@ -19,20 +19,19 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-import numba
 import numpy as np
 
 from tmem.law.modal import gains_for, interaction_point
 from tmem.world.initial import InitialArrays, build
 from tmem.vehicles import vehicle_model
-from tmem.world.neighbors import all_pairs, arrange, spatial_order, verlet_pairs
+from tmem.world.neighbors import spatial_order
 from tmem.scenario import Scenario
 from tmem.scenario.sensing_table import SensingParams
 from tmem.world.sensing import exact, sensing_of
 from tmem.engine.checkpoint import Checkpoints, Saved, restore
 from tmem.engine.loop import advance_for
 from tmem.engine.variants import Variant
-from tmem.engine.pushes import CHUNK
+from tmem.engine.lists import NeighbourLister
 from tmem.engine.gas import SNAPSHOT, TOTALS, gas_record
 from tmem.law.record import law_of
 from tmem.engine.records import (
@@ -45,9 +44,6 @@ from tmem.terms import term_class
 #: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal
 #: at 10^4).
 THREADED_SWARM = 10_000
-#: Agents per block of the neighbour sums (:func:`tmem.world.neighbors.arrange`); it fixes the order of
-#: each agent's sum, so results do not depend on the number of threads.
-BLOCK = 4096
 
 
 def record_steps(n_steps: int, record_every: int) -> np.ndarray:
@@ -82,55 +78,6 @@ def _commands(scenario: Scenario, edges: np.ndarray, slot: np.ndarray) -> Comman
     flat = np.array([t for row in targets for t in row], dtype=np.int64)
     value = np.array([np.nan if cmd.value is None else cmd.value for cmd in commands], dtype=float)
     return Commands(step, kind, ptr, flat, value)
-
-
-def _partners(n_agents: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each agent's formation partners, in rows ``(ptr, idx)``."""
-    both = np.concatenate([edges, edges[:, ::-1]]) if len(edges) else np.empty((0, 2), dtype=np.int64)
-    order = np.lexsort((both[:, 1], both[:, 0]))
-    both = both[order]
-    ptr = np.searchsorted(both[:, 0], np.arange(n_agents + 1)).astype(np.int64)
-    return ptr, both[:, 1].astype(np.int64).copy()
-
-
-class _NeighbourLister:
-    """Lists the pairs of flying agents in the loop's order, with Verlet lists or every pair.
-
-    The lists hold the pairs within ``reach`` and the skin of each other in ``p_ref``: ``P*`` (6) and
-    ``R + R_j`` on the exact path, the positions and the sensing range on the sensed one."""
-
-    def __init__(self, scenario: Scenario, n_agents: int, n_axes: int, edges_in_slots: np.ndarray, use_lists: bool,
-                 reach: float):  # fmt: skip
-        self.cutoff = reach + scenario.neighbors.skin
-        self.use_lists = use_lists
-        self.adj_ptr, self.adj_idx = _partners(n_agents, edges_in_slots)
-        self.block_ptr = np.empty(n_agents // BLOCK + 2, dtype=np.int64)
-        self.block_nearest2 = np.empty(len(self.block_ptr) - 1)
-        self.block_shift2 = np.empty(len(self.block_ptr) - 1)
-        self.chunks = np.empty((len(self.block_ptr), 2 * n_axes + 1, CHUNK))
-        self.closest = np.full(1, np.inf)  # the smallest squared distance between neighbours so far
-        self.p_ref = np.zeros((n_agents, n_axes))
-        if use_lists:  # pairs are unsigned, as all_pairs gives them: no negative-index check in the loop
-            self.pairs = np.empty((8 * n_agents, 2), dtype=np.uint32)
-            self.found = np.empty((2, len(self.pairs) + 64), dtype=np.int32)
-        self.builds = 0
-
-    def list(self, active: np.ndarray, box: tuple) -> Neighbours:
-        """The pairs within reach and skin of each other in ``p_ref``, each once; grow the arrays if needed."""
-        if self.use_lists:
-            parts = numba.get_num_threads()
-            listed, room = verlet_pairs(self.p_ref, active, self.cutoff, box, self.pairs, self.found, parts)
-            if listed > len(self.pairs) or room > self.found.shape[1]:
-                self.pairs = np.empty((int(1.5 * max(listed, len(self.pairs))) + 16, 2), dtype=np.uint32)
-                self.found = np.empty((2, int(1.5 * max(room, self.found.shape[1])) + 16), dtype=np.int32)
-                verlet_pairs(self.p_ref, active, self.cutoff, box, self.pairs, self.found, parts)
-            self.builds += 1
-        else:
-            self.pairs = all_pairs(active)
-            listed = len(self.pairs)
-        n_inside, n_pairs = arrange(self.pairs, listed, self.adj_ptr, self.adj_idx, BLOCK, self.block_ptr)
-        return Neighbours(self.pairs, n_inside, n_pairs, self.block_ptr, self.p_ref, self.block_nearest2,
-                          self.block_shift2, self.closest, self.chunks)  # fmt: skip
 
 
 def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int,
@@ -280,7 +227,7 @@ def simulate(
 
 
 def _read_back(scenario: Scenario, initial: InitialArrays, model, gains: np.ndarray, swarm: _Slots,
-               lister: _NeighbourLister) -> Trajectory:  # fmt: skip
+               lister: NeighbourLister) -> Trajectory:  # fmt: skip
     """The trajectory of a finished run, its agents translated from slots back to their numbers."""
     sim = scenario.simulation
     x = swarm.agents.state
@@ -318,7 +265,7 @@ def _lists_and_measurement(scenario: Scenario, run: Run, swarm: _Slots, gains: n
     sensed = _sensed(scenario, settings, run, overrides)
     edges = np.stack([swarm.pairs.i, swarm.pairs.j], axis=1)
     reach = settings.range if sensed and run.use_lists else scenario.interaction.reach
-    lister = _NeighbourLister(scenario, x.shape[0], x.shape[1], edges, run.use_lists, reach)
+    lister = NeighbourLister(scenario, x.shape[0], x.shape[1], edges, run.use_lists, reach)
     lister.p_ref[:] = x[..., 0] if sensed else interaction_point(x, gains)  # what the lists hold, at the start
     if not sensed:
         return lister, exact(x), False
@@ -379,7 +326,7 @@ def _changing(swarm: _Slots, neighbours: Neighbours, stages: Stages) -> dict:
                 counters=swarm.counters, gas=stages.gas, sensing=stages.knowledge, terms=stages.terms)  # fmt: skip
 
 
-def _drive(advance, run: Run, stages: Stages, swarm: _Slots, lister: _NeighbourLister, progress, chunk_seconds: float,
+def _drive(advance, run: Run, stages: Stages, swarm: _Slots, lister: NeighbourLister, progress, chunk_seconds: float,
            checkpoints: Checkpoints | None, resume: Saved | None) -> None:  # fmt: skip
     """Run the compiled loop ``advance`` over every step, in chunks of about ``chunk_seconds``,
     listing the neighbours again whenever the loop asks.  With ``checkpoints``, chunks end at the

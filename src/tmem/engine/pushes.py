@@ -17,7 +17,7 @@ import numpy as np
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law.interaction.kernels import push_factor
 from tmem.world.space import nearest_image
-from tmem.engine.gas import add_contact, pair_share, virial_by_pairs
+from tmem.engine.gas_counts import add_contact, pair_share, virial_by_pairs
 
 #: Pairs are summed in chunks of this many: gathered, then pushed in vectorised arithmetic, then added.
 CHUNK = 256

@@ -226,8 +226,8 @@ class Gas(NamedTuple):
     first : ndarray, shape (1,), bool
         True until the first step's neighbours are counted: they are not encounters.
     work : ndarray, shape (agents, 5 + axes) (no rows when not observed)
-        Each agent's work space of a count, in the columns :data:`tmem.engine.gas_columns.NEAR` ...
-        :data:`tmem.engine.gas_columns.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's
+        Each agent's work space of a count, in the columns :data:`tmem.engine.gas_counts.NEAR` ...
+        :data:`tmem.engine.gas_counts.NEIGHBOUR_VELOCITY`: one row per agent, so that a pair's
         counts touch two rows.
     weight : ndarray, shape (agents,)
         The weight of each agent's pushes, ``1 / max(1, contacts)`` (C1), which it broadcasts at each
@@ -239,7 +239,7 @@ class Gas(NamedTuple):
         push (:mod:`tmem.engine.thermostat`).
     held : ndarray, shape (agents, 1 + axes)
         What the thermostat holds from one count to the next, in the columns of
-        :mod:`tmem.engine.gas_columns` (T3).
+        :mod:`tmem.engine.gas_counts` (T3).
     pushed : ndarray, shape (agents, axes)
         Work space: the pushes of the walls and obstacles this step.
     totals : ndarray, shape (agents, 6)

@@ -21,7 +21,8 @@ from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before a
 from tmem.law import coupling
 from tmem.law.modal import corrected_position, gains_row, tilt_scale
 from tmem.world.space import nearest_image
-from tmem.engine.gas import clear, limit_of, record_totals
+from tmem.engine.gas import limit_of, record_totals
+from tmem.engine.gas_counts import clear
 from tmem.engine.records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
 
 @numba.njit(cache=True, inline="always")
@@ -150,7 +151,7 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 def corrected_positions(known, agents, law, run, neighbours, gas, listed, counting):
     """``P* = x . K / K_P`` (6) of every agent as it knows itself, and its true ``P``, into
     ``agents.corrected``; clear the set-points (and, at a count of the gas, its counts:
-    :func:`tmem.engine.gas.clear`).
+    :func:`tmem.engine.gas_counts.clear`).
 
     Returns the largest squared shift of a flying agent's listed point (``P*``, or ``P`` with sensing)
     since the lists were built (0 without lists).

@@ -18,7 +18,7 @@ own state and the velocities of the neighbours it counts.
   opposite whatever the thermostat does, and the tilt may reach ``2 c_max``.
 * **Walls and obstacles are left their bounces.**  A wall is a neighbour held still, which shares
   no common motion with the agent: within a wall's or an obstacle's reach the thermostat does not
-  push the agent at all (:func:`tmem.engine.gas.gas_pushes`).
+  push the agent at all (:func:`tmem.engine.gas.gas_agent`).
 
 The group's push (T3) is found at each count (:func:`hold_group_push`) from the neighbours counted
 then, and held until the next; the free agent's part (T1) follows its velocity at every step
@@ -32,7 +32,7 @@ import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law.modal import saturation
-from tmem.engine.gas_columns import COMMON, CONTACT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
+from tmem.engine.gas_counts import COMMON, CONTACT, NEIGHBOUR_SPEED2, NEIGHBOUR_VELOCITY, SPEED2, TOGETHER
 
 #: The common velocity's square counts as at least this share of the group's mean ``|V|^2`` (T3): a
 #: pair meeting head-on has no common motion to heat, and is left as it is, not pushed hard along a
@@ -64,7 +64,7 @@ def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
         The states as known.
     work, held : ndarray
         ``Gas.work``, with the count's sums, and ``Gas.held``, changed in place
-        (:mod:`tmem.engine.gas_columns`).
+        (:mod:`tmem.engine.gas_counts`).
     rate : float
         ``1 / (2 tau)`` (1/s).
     target2 : float
