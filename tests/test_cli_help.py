@@ -1,5 +1,6 @@
 """The command line looks finished: ``tmem --version``, and every command's help free of raw markup,
-of ``--help <bool>``, with each numeric option's unit and default shown."""
+of ``--help <bool>``, with each numeric option's unit and default shown; docs/cli.md names every
+command, argument and option, and none that does not exist."""
 
 import re
 import tomllib
@@ -63,3 +64,32 @@ def test_numeric_options_show_their_unit_and_default(name):
     for line in text.splitlines():  # any option line with a number in it says what the number is
         if line.lstrip("│ ").startswith("-") and re.search(r"\d", line.split(">", 1)[-1]):
             assert "[default:" in line or UNITS.search(line.lower()), line
+
+
+def reference_sections() -> dict[str, str]:
+    """docs/cli.md's section of each command, by name (from its heading ``## `tmem NAME` ``)."""
+    text = (Path(__file__).parent.parent / "docs" / "cli.md").read_text()
+    parts = re.split(r"^## `tmem (\w+)`\n", text, flags=re.M)
+    return {name: re.split(r"^## ", body, flags=re.M)[0] for name, body in zip(parts[1::2], parts[2::2])}
+
+
+def test_the_reference_has_a_section_for_every_command():
+    assert set(reference_sections()) == {n for n in commands() if n}
+    assert "`tmem --version`" in (Path(__file__).parent.parent / "docs" / "cli.md").read_text()
+
+
+@pytest.mark.parametrize("name", [n for n in commands() if n], ids=str)
+def test_the_reference_names_every_argument_and_option_of_a_command_and_no_other(name):
+    """docs/cli.md, in the command's section: each argument and each option's flags; an option it names
+    that the command does not have fails."""
+    text = reference_sections()[name]
+    params = [p for p in commands()[name].params if p.name != "help"]
+    for param in params:
+        if param.param_type_name == "argument":
+            assert f"`{param.name.upper()}`" in text, param.name
+        else:
+            for flag in param.opts:
+                assert re.search(rf"`{re.escape(flag)}\b", text), flag
+    flags = {flag for p in params for flag in p.opts} | {"--help"}
+    named = set(re.findall(r"(?<![\w-])(--[a-z][a-z-]*)", text))
+    assert named <= flags, named - flags
