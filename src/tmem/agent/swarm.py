@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmem.law.modal import gains_for
 from tmem.engine.driver import record_steps, slot_order
 from tmem.law.record import law_of
 from tmem.engine.trajectory import Event
@@ -74,7 +73,7 @@ def _refusal(scenario: Scenario) -> tuple[str, str] | None:
 def controllers_for(scenario: Scenario) -> list[AgentController]:
     """One controller per agent of ``scenario``, in the order of its agents.
 
-    Each has the scenario's gains (:func:`tmem.law.modal.gains_for` on the vehicle model) and law
+    Each has the scenario's gains (:meth:`tmem.vehicles.base.VehicleModel.gains`) and law
     (:func:`tmem.law.record.law_of`), its agent's formation edges, the scenario's couple and
     uncouple commands that name one of them (or every pair), and the engine's order of the
     neighbours' pushes (:func:`tmem.engine.driver.slot_order`).
@@ -91,8 +90,8 @@ def controllers_for(scenario: Scenario) -> list[AgentController]:
     """
     _refuse_what_is_not_flown(scenario)
     c, ia, sim = scenario.controller, scenario.interaction, scenario.simulation
-    linearisation = vehicle_model(scenario.model).linearisation()
-    gains = gains_for(*linearisation, c.r_l, c.im_l, c.im_r)
+    model = vehicle_model(scenario.model)
+    linearisation, gains = model.linearisation(), model.gains(c.r_l, c.im_l, c.im_r)
     law, _ = law_of(scenario, linearisation, gains)
     initial = build(scenario)
     n = scenario.n_agents
@@ -194,7 +193,7 @@ def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None
     controllers = _controllers_to_fly(scenario, controllers)
     sim = scenario.simulation
     model = vehicle_model(scenario.model, scenario.wind)
-    vehicle_step, hold = type(model).step, model.step_params(sim.dt)  # the class's kernel, not a bound method
+    vehicle_step, hold = model.kernel(), model.step_params(sim.dt)
     x = build(scenario).state.copy()
     body = model.initial_body(x)
     n, n_axes = x.shape[:2]

@@ -36,9 +36,9 @@ The closed loop, with each pair's push weighted (1 inside, 0 outside,
 ``alpha`` while sliding), is :class:`_ClosedLoop`; :func:`integrate` runs it
 segment by segment, each segment with the pairs' modes fixed.
 
-Supported: one axis, a vehicle model whose state is ``(P, V, phi, omega)``
-(the loop integrated is that of its linearisation ``(A, B)``, the linear
-model (2) itself), functions without a coupling flag (the flag of (10)-(11)
+Supported: one axis, a vehicle model whose state is the law's (the loop
+integrated is that of its linearisation ``(A, B)``: the linear model (2)
+itself, or the ground robot's (R1) while its drive is not saturated), functions without a coupling flag (the flag of (10)-(11)
 changes at sampled instants in the engine), and at most one pair sliding at
 a time.
 """
@@ -51,7 +51,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from tmem.law.modal import gains_for, interaction_point
+from tmem.law.modal import interaction_point
 from tmem.engine import record_steps
 from tmem.world.initial import build
 from tmem.law.interaction import evaluate, uses_coupling
@@ -163,10 +163,10 @@ def _check(scenario: Scenario, model: VehicleModel) -> None:
             f"whole of {model.kind!r}: its body state {tuple(model.body_names)} has no place in it"
         )
     names = tuple(model.state_names)
-    if len(names) != 4:
+    if len(names) != model.law_states:
         raise ValueError(
-            f"model.kind: the continuous reference needs the state (P, V, phi, omega) of its "
-            f"linearisation, got {len(names)} components {names} for {model.kind!r}"
+            f"model.kind: the continuous reference needs the state of its linearisation, the law's "
+            f"{model.law_states} components, got {len(names)} components {names} for {model.kind!r}"
         )
 
 
@@ -201,7 +201,7 @@ class _ClosedLoop:
     def __init__(self, scenario: Scenario, model: VehicleModel):
         c, ia = scenario.controller, scenario.interaction
         self.a, self.b = model.linearisation()
-        self.gains = gains_for(self.a, self.b, c.r_l, c.im_l, c.im_r)
+        self.gains = model.gains(c.r_l, c.im_l, c.im_r)
         self.n_state = len(model.state_names)
         x0 = build(scenario).state[:, 0, :]
         self.n_agents = x0.shape[0]

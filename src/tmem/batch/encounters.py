@@ -32,12 +32,12 @@ import numpy as np
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law import coupling
 from tmem.batch.free_flight import level
-from tmem.law.modal import corrected_position, gains_for, gains_row, tilt_scale
+from tmem.law.modal import corrected_position, gains_row, tilt_scale
 from tmem.law.record import law_of
 from tmem.engine.pairs import formation_pair
 from tmem.engine.records import Agents, Counters, Events, Pairs
 from tmem.vehicles import vehicle_model
-from tmem.vehicles.linear import step_zero_order_hold
+from tmem.vehicles.linear import LinearModel
 from tmem.batch.relative import LANES, run_relative
 from tmem.scenario import LIMIT, Scenario
 
@@ -62,6 +62,9 @@ class BatchResult:
         return ~np.isnan(self.couple_time)
 
 
+
+#: The linear model's exact step (2), which the batch takes.
+_linear_step = LinearModel.kernel()
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -148,7 +151,7 @@ def _case_step(k, e, x, agents, pairs, law, params, box, hold, command_step, n_s
     formation_pair(k, e, x, agents, pairs, law, params, box, events, counters)
     if k < n_steps:
         for s in (i, j):
-            step_zero_order_hold(x, agents.body, agents.setpoint, s, tilt_scale(agents.setpoint, s, n_axes, params.c_max), hold, n_axes)
+            _linear_step(x, agents.body, agents.setpoint, s, tilt_scale(agents.setpoint, s, n_axes, params.c_max), hold, n_axes)
     return k + 1
 
 
@@ -293,7 +296,7 @@ def run_batch(scenario: Scenario, positions: np.ndarray, velocities: np.ndarray)
     c, sim = scenario.controller, scenario.simulation
     model = vehicle_model(scenario.model)
     linearisation = model.linearisation()
-    law, params = law_of(scenario, linearisation, gains_for(*linearisation, c.r_l, c.im_l, c.im_r))
+    law, params = law_of(scenario, linearisation, model.gains(c.r_l, c.im_l, c.im_r))
     command_step = sim.step_of(scenario.commands[0].time) if scenario.commands else -1
     hold = model.step_params(sim.dt)
     cases = len(positions)

@@ -25,8 +25,10 @@ from tmem.law import coupling
 from tmem.batch.free_flight import level, steps_before_contact
 from tmem.law.modal import corrected_position
 from tmem.law.interaction.kernels import pair_control
-from tmem.vehicles.linear import hold_step
+from tmem.vehicles.linear import LinearModel
 
+#: The linear model's exact step (2): the relative state steps as an agent does, with the input ``U_1 - U_0``.
+_linear_step = LinearModel.kernel()
 #: Cases advanced side by side in one loop.  One case's step depends on its last, so alone it waits
 #: on its own arithmetic; interleaving independent cases lets the processor overlap them.
 LANES = 8
@@ -107,12 +109,13 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
     gains = law.gains
     reach, d_t, eps, c_max = params.reach, params.d_t, law.eps, params.c_max
     function, couples, at_crossing = law.function, law.couples, law.at_crossing
-    ad, bd = hold.ad, hold.bd
     n_cases = e0.shape[0]
     for block in numba.prange((n_cases + LANES - 1) // LANES):
         first = block * LANES
         lanes = min(LANES, n_cases - first)
         e = _lane_states(e0, first, lanes)
+        u = np.zeros((LANES, 1))  # each case's U_1 - U_0 as the step takes it
+        no_body = np.empty((LANES, 0))
         flag = np.zeros(LANES, dtype=np.int64)
         armed = np.ones(LANES, dtype=np.int64)
         r_before = np.full(LANES, np.nan)
@@ -142,8 +145,8 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
                     _flag_step(flag, armed, r_before, coupled_at, uncoupled_at, c, k[c], r, d_t, eps, at_crossing)
                 u0 = _push_on_first(function, r, flag[c], params, d, c_max)
                 if k[c] < n_steps:
-                    e[c, 0, 0], e[c, 0, 1], e[c, 0, 2], e[c, 0, 3] = hold_step(ad, bd, e[c, 0, 0], e[c, 0, 1], e[c, 0, 2],
-                                                                               e[c, 0, 3], -2.0 * u0)
+                    u[c, 0] = -2.0 * u0
+                    _linear_step(e, no_body, u, c, 1.0, hold, 1)
                 k[c] += 1
         for lane in range(lanes):
             for m in range(e0.shape[1]):

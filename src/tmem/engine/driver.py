@@ -21,7 +21,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from tmem.law.modal import gains_for, interaction_point
+from tmem.law.modal import interaction_point
 from tmem.world.initial import InitialArrays, build
 from tmem.vehicles import vehicle_model
 from tmem.world.neighbors import spatial_order
@@ -208,7 +208,7 @@ def simulate(
     resume = checkpoints.start(scenario, record, sensing) if checkpoints is not None else None
     sim, c = scenario.simulation, scenario.controller
     model = vehicle_model(scenario.model, scenario.wind)
-    gains = gains_for(*model.linearisation(), c.r_l, c.im_l, c.im_r)
+    gains = model.gains(c.r_l, c.im_l, c.im_r)
     initial = build(scenario)
     run = _run_of(scenario, initial, record)
     law, params = law_of(scenario, model.linearisation(), gains)
@@ -217,7 +217,7 @@ def simulate(
     lister, measured, sensed = _lists_and_measurement(scenario, run, swarm, gains, sensing)
     terms = {name: term_class(name).record(getattr(scenario, name), scenario, gains) for name in scenario.agent_terms}
     stages = Stages(law=law, params=params, vehicle=model.step_params(sim.dt), knowledge=measured,
-                    gas=gas_record(scenario, float(model.linearisation()[0][1, 2]), x.shape[0], float(gains[0])), terms=terms)
+                    gas=gas_record(scenario, model.acceleration_per_input(), x.shape[0], float(gains[0])), terms=terms)
     variant = Variant(vehicle=scenario.model.kind, knowledge="sensed" if sensed else "exact", terms=tuple(terms),
                       gas=stages.gas.observe, threaded=x.shape[0] >= THREADED_SWARM)  # fmt: skip
     _drive(advance_for(variant), run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)

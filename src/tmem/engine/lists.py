@@ -35,7 +35,21 @@ class NeighbourLister:
     """Lists the pairs of flying agents in the loop's order, with Verlet lists or every pair.
 
     The lists hold the pairs within ``reach`` and the skin of each other in ``p_ref``: ``P*`` (6) and
-    ``R + R_j`` on the exact path, the positions and the sensing range on the sensed one."""
+    ``R + R_j`` on the exact path, the positions and the sensing range on the sensed one.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its neighbour lists' skin.
+    n_agents, n_axes : int
+        The run's agents and axes.
+    edges_in_slots : ndarray, shape (pairs, 2)
+        The formation pairs, in slots: they are not listed (their own stage pushes them).
+    use_lists : bool
+        Verlet lists (True), or every pair of flying agents.
+    reach : float
+        The distance within which a pair is listed, before the skin (m).
+    """
 
     def __init__(self, scenario: Scenario, n_agents: int, n_axes: int, edges_in_slots: np.ndarray, use_lists: bool,
                  reach: float):  # fmt: skip
@@ -54,7 +68,15 @@ class NeighbourLister:
         self.builds = 0
 
     def list(self, active: np.ndarray, box: tuple) -> Neighbours:
-        """The pairs within reach and skin of each other in ``p_ref``, each once; grow the arrays if needed."""
+        """The pairs within reach and skin of each other in ``p_ref``, each once; grow the arrays if needed.
+
+        Parameters
+        ----------
+        active : ndarray, shape (agents,), bool
+            The flying agents.
+        box : tuple of float
+            The periodic box's sides (0: open axis).
+        """
         if self.use_lists:
             parts = numba.get_num_threads()
             listed, room = verlet_pairs(self.p_ref, active, self.cutoff, box, self.pairs, self.found, parts)

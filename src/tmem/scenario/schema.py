@@ -126,8 +126,8 @@ class _Scenario(StrictModel):
     @property
     def position_gain(self) -> float:
         """``K_P`` of the law (rad/m): the modal gain on position that places the roots (5) (:func:`tmem.law.modal.modal_gains`)."""
-        c, model = self.controller, self.model
-        return (c.r_l**2 + c.im_l**2) * c.im_r**2 / (model.g * model.kp * model.kd)
+        c = self.controller
+        return self.model.position_gain(c.r_l, c.im_l, c.im_r)
 
     @property
     def gas_observed(self) -> bool:
@@ -205,9 +205,8 @@ class _Scenario(StrictModel):
                 "simulation.record_agents", "is empty and there are no pairs to record: the run would record nothing"
             )
         check_commands(self, n, pairs)
-        for name in self.agent_terms:
-            table = getattr(self, name)
-            if hasattr(table, "check"):
+        for table in (self.model, *(getattr(self, name) for name in self.agent_terms)):
+            if hasattr(table, "check"):  # a vehicle's or a term's own checks against the scenario
                 table.check(self)
         check_record_size(self, n, len(pairs))
         self._check_formation_room(axes, n)

@@ -14,130 +14,15 @@ at fault.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Literal, Union
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from tmem.law.interaction.registry import FUNCTION_NAMES
-from tmem.vehicles import MODELS
-
-
-class ScenarioError(ValueError):
-    """A scenario that cannot be run; the message is one line naming the field."""
-
-
-class FieldError(ValueError):
-    """Raised by a cross-field check to name the field at fault, relative to its table.
-
-    Parameters
-    ----------
-    field : str
-        The field at fault, relative to its table (``"d_t"``).
-    reason : str
-        Why, in one line.
-    """
-
-    def __init__(self, field: str, reason: str):
-        super().__init__(reason)
-        self.field = field
-        self.reason = reason
-
-
-def per_axis(axes: int, got: int) -> str:
-    """Why a list of ``got`` values is refused where one value per axis is needed, and the fix.
-
-    Parameters
-    ----------
-    axes : int
-        ``space.axes``.
-    got : int
-        How many values were given.
-    """
-    reason = f"needs {axes} value{'s' if axes > 1 else ''}, one per axis (space.axes = {axes}), got {got}"
-    if 1 <= got <= 3:
-        reason += f"; for a {got}-D run set axes = {got} in [space]"
-    return reason
-
-
-class StrictModel(BaseModel):
-    """Base of the scenario tables: unknown keys, non-finite numbers and quiet coercions refused."""
-
-    # strict: no quiet coercion of true to 1 or "6.0" to 6.0.
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
-
-
-#: Every number is bounded in magnitude, so that no product in the model overflows.
-LIMIT = 1e9
-Number = Annotated[float, Field(ge=-LIMIT, le=LIMIT)]
-Positive = Annotated[float, Field(gt=0, le=LIMIT)]
-NonNegative = Annotated[float, Field(ge=0, le=LIMIT)]
-Pair = Annotated[list[int], Field(min_length=2, max_length=2)]
-
-
-class LinearModelParams(StrictModel):
-    """Quadrocopter model (1)-(2), linear per axis, Table 1: ``[model] kind = "linear"``."""
-
-    kind: Literal["linear"] = "linear"
-    kp: Positive = 6.0
-    kd: Positive = 25.0
-    g: Positive = 9.8
-
-    #: The most axes a run of this model may have.
-    max_axes: ClassVar[int] = 3
-
-
-#: Most of ``kd x inner_period``: the rate loop (Q6) held over a sub-step stays close to the
-#: continuous one (docs/vehicles.md).
-MAX_RATE_LOOP_STEP = 0.25
-
-
-class QuadrotorModelParams(StrictModel):
-    """A nonlinear quadrotor under the paper's inner loop, ``[model] kind = "quadrotor"``
-    (:mod:`tmem.vehicles.quadrotor`).  Defaults: the Crazyflie 2.x as RotorPy gives it
-    (``docs/vehicles.md`` names the source of each number)."""
-
-    kind: Literal["quadrotor"]
-    kp: Positive = 6.0
-    kd: Positive = 25.0
-    g: Positive = 9.81
-    mass: Positive = 0.03
-    ixx: Positive = 1.43e-5
-    iyy: Positive = 1.43e-5
-    izz: Positive = 2.89e-5
-    arm_length: Positive = 0.043
-    k_eta: Positive = 2.3e-8
-    k_m: Positive = 7.8e-10
-    rotor_drag: NonNegative = 1.02506e-6
-    inflow_drag: NonNegative = 7.553e-7
-    c_dx: NonNegative = 0.0
-    c_dy: NonNegative = 0.0
-    c_dz: NonNegative = 0.0
-    tau_m: Annotated[float, Field(ge=1e-6, le=LIMIT)] = 0.072
-    rotor_speed_max: Positive = 2500.0
-    altitude_kp: Positive = 16.0
-    altitude_kd: Positive = 8.0
-    inner_period: Annotated[float, Field(ge=1e-6, le=1.0)] = 0.002
-    drag_feedforward: bool = True
-    #: ``"acceleration"``: the airframe asked for (2)'s acceleration, (Q9)-(Q11); ``"tilt"``: the
-    #: set-point ``U`` to the attitude loop, with the drag feed-forward (Q8) (docs/vehicles.md).
-    inner_loop: Literal["acceleration", "tilt"] = "acceleration"
-
-    #: The most axes a run of this model may have: the vertical one is the altitude hold's.
-    max_axes: ClassVar[int] = 2
-
-    @model_validator(mode="after")
-    def _flies(self) -> "QuadrotorModelParams":
-        hover = (self.mass * self.g / (4.0 * self.k_eta)) ** 0.5
-        if hover >= 0.9 * self.rotor_speed_max:
-            raise FieldError("rotor_speed_max", f"{self.rotor_speed_max:g} rad/s leaves no margin above the hover "
-                             f"speed sqrt(m g / (4 k_eta)) = {hover:.4g} rad/s (at least 10 %)")  # fmt: skip
-        if self.kd * self.inner_period > MAX_RATE_LOOP_STEP:
-            raise FieldError("inner_period", f"{self.inner_period:g} s is too long for the rate loop: kd x inner_period = "
-                             f"{self.kd * self.inner_period:.3g}, at most {MAX_RATE_LOOP_STEP:g}")  # fmt: skip
-        if not self.drag_feedforward and self.inner_loop == "acceleration":
-            raise FieldError("drag_feedforward", 'false is the tilt loop\'s (inner_loop = "tilt"): the acceleration loop '
-                             "cancels the drag it feels")  # fmt: skip
-        return self
+from tmem.scenario.fields import (  # noqa: F401  (the tables' types, importable from here too)
+    LIMIT, FieldError, NonNegative, Number, Pair, Positive, ScenarioError, StrictModel, per_axis,
+)
+from tmem.vehicles import VEHICLES, vehicle_table
 
 
 def _linear_unless_named(table: object) -> object:
@@ -147,15 +32,19 @@ def _linear_unless_named(table: object) -> object:
     return table
 
 
-#: The ``[model]`` table: one class per vehicle model, chosen by its ``kind`` (add a class to the
-#: union for a new kind; pydantic then reports an unknown kind as ``model.kind``).
+#: The model kinds a scenario may name (the vehicle registry, :data:`tmem.vehicles.VEHICLES`).
+MODEL_KINDS: tuple[str, ...] = tuple(VEHICLES)
+#: The ``[model]`` table: each vehicle's own (:meth:`tmem.vehicles.vehicle_table`), chosen by its ``kind``
+#: (pydantic reports an unknown kind as ``model.kind``).
 ModelParams = Annotated[
-    LinearModelParams | QuadrotorModelParams,
+    Union[tuple(vehicle_table(kind) for kind in MODEL_KINDS)],  # noqa: UP007  (a union built from the registry)
     BeforeValidator(_linear_unless_named),
     Field(discriminator="kind"),
 ]
-#: The model kinds a scenario may name (the vehicle-model registry; it loads no compiled code).
-MODEL_KINDS: tuple[str, ...] = tuple(MODELS)
+#: The linear model's table, the default ``[model]``.
+LinearModelParams = vehicle_table("linear")
+#: The quadrotor's table.
+QuadrotorModelParams = vehicle_table("quadrotor")
 
 
 class ControllerParams(StrictModel):

@@ -19,13 +19,13 @@ sampling the control.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from functools import cache
+from typing import ClassVar, Literal, NamedTuple
 
-import numba
 import numpy as np
 from scipy.linalg import expm
 
-from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.scenario.fields import Positive, StrictModel
 from tmem.vehicles.base import VehicleModel
 
 #: Names of the four state components, in the order the arrays use.
@@ -93,63 +93,64 @@ class HoldStep(NamedTuple):
     bd: np.ndarray
 
 
-@numba.njit(cache=True, inline="always")
-def hold_step(ad, bd, x0, x1, x2, x3, u):
-    """One zero-order-hold step of one axis, ``Ad x + Bd U``, as four numbers.
+def _step(x, body, u, i, scale, params, n_axes):
+    """Advance agent ``i`` of ``x`` (agents, axes, 4) over one step with ``U = u[i] * scale`` held (2):
+    ``x <- Ad x + Bd U`` on each axis (``params`` a :class:`HoldStep`; ``body`` has no columns).
 
-    Parameters
-    ----------
-    ad : ndarray, shape (4, 4)
-    bd : ndarray, shape (4,)
-        ``(Ad, Bd)`` of :func:`zero_order_hold`.
-    x0, x1, x2, x3 : float
-        The state ``(P, V, phi, omega)`` (m, m/s, rad, rad/s).
-    u : float
-        The tilt set-point ``U`` held over the step (rad).
+    Compiled by :meth:`LinearModel.kernel`.
     """
-    return (
-        ad[0, 0] * x0 + ad[0, 1] * x1 + ad[0, 2] * x2 + ad[0, 3] * x3 + bd[0] * u,
-        ad[1, 0] * x0 + ad[1, 1] * x1 + ad[1, 2] * x2 + ad[1, 3] * x3 + bd[1] * u,
-        ad[2, 0] * x0 + ad[2, 1] * x1 + ad[2, 2] * x2 + ad[2, 3] * x3 + bd[2] * u,
-        ad[3, 0] * x0 + ad[3, 1] * x1 + ad[3, 2] * x2 + ad[3, 3] * x3 + bd[3] * u,
-    )
-
-
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def step_zero_order_hold(x, body, u, i, scale, params, n_axes):
-    """Advance agent ``i`` of ``x`` (agents, axes, 4) over one step with ``U = u[i] * scale`` held (2).
-
-    Parameters
-    ----------
-    x : ndarray, shape (agents, axes, 4)
-        States, changed in place.
-    body : ndarray, shape (agents, 0)
-        The body states: the linear model has none.
-    u : ndarray, shape (agents, axes)
-        Summed tilt set-points (rad).
-    i : int
-        The agent.
-    scale : float
-        Saturation factor of ``u[i]`` (:func:`tmem.law.modal.tilt_scale`).
-    params : HoldStep
-        ``(Ad, Bd)`` for the time step.
-    n_axes : int
-        Number of axes.
-    """
+    ad, bd = params.ad, params.bd
     for a in range(n_axes):
-        x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3] = hold_step(
-            params.ad, params.bd, x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3], u[i, a] * scale
-        )
+        x0, x1, x2, x3, v = x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3], u[i, a] * scale
+        x[i, a, 0] = ad[0, 0] * x0 + ad[0, 1] * x1 + ad[0, 2] * x2 + ad[0, 3] * x3 + bd[0] * v
+        x[i, a, 1] = ad[1, 0] * x0 + ad[1, 1] * x1 + ad[1, 2] * x2 + ad[1, 3] * x3 + bd[1] * v
+        x[i, a, 2] = ad[2, 0] * x0 + ad[2, 1] * x1 + ad[2, 2] * x2 + ad[2, 3] * x3 + bd[2] * v
+        x[i, a, 3] = ad[3, 0] * x0 + ad[3, 1] * x1 + ad[3, 2] * x2 + ad[3, 3] * x3 + bd[3] * v
+
+
+class TiltingGain:
+    """What the tables of tilting multirotors share (their ``kp``, ``kd`` and ``g``): the law's gain
+    on position that they give."""
+
+    def position_gain(self, r_l: float, im_l: float, im_r: float) -> float:
+        """``K_P`` of (4) on the model (2) with this table's numbers: ``(r_l^2 + im_l^2) im_r^2 / (g kp kd)``.
+
+        Parameters
+        ----------
+        r_l, im_l, im_r : float
+            The roots (5) (1/s).
+        """
+        return (r_l**2 + im_l**2) * im_r**2 / (self.g * self.kp * self.kd)
+
+
+class LinearModelParams(TiltingGain, StrictModel):
+    """Quadrocopter model (1)-(2), linear per axis, Table 1: ``[model] kind = "linear"``."""
+
+    kind: Literal["linear"] = "linear"
+    kp: Positive = 6.0
+    kd: Positive = 25.0
+    g: Positive = 9.8
+
+    #: The most axes a run of this model may have.
+    max_axes: ClassVar[int] = 3
 
 
 class LinearModel(VehicleModel):
     """The linear model (2) of each horizontal axis, with the parameters ``kp``, ``kd``, ``g`` of Table 1."""
 
     kind = "linear"
+    table = LinearModelParams
     state_names = STATE_NAMES
     state_units = ("m", "m s-1", "rad", "rad s-1")
     long_names = ("position", "velocity", "tilt from the vertical", "tilt rate")
-    step = step_zero_order_hold
+
+    @classmethod
+    @cache
+    def kernel(cls):
+        """The compiled step :func:`_step`, the exact zero-order hold of (2) (compiled on first use)."""
+        import numba
+
+        return numba.njit(inline="always", error_model="numpy")(_step)
 
     def linearisation(self) -> tuple[np.ndarray, np.ndarray]:
         """``(A, B)`` of (2): the model is its own linearisation."""

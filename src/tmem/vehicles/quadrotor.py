@@ -39,6 +39,7 @@ import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.vehicles.base import VehicleModel
+from tmem.vehicles.quadrotor_table import QuadrotorModelParams
 from tmem.vehicles.flight_controller import (REFERENCE_FIELDS, REFERENCE_LONG_NAMES, REFERENCE_NAMES, REFERENCE_UNITS, acceleration_loop,
                                 advance_reference, initial_reference, rate_loop, reference_hold, tilt_loop,
                                 reported_coordinates)
@@ -231,7 +232,7 @@ class QuadrotorModel(VehicleModel):
     Parameters
     ----------
     params
-        The scenario's ``[model]`` table, :class:`~tmem.scenario.tables.QuadrotorModelParams`.
+        The scenario's ``[model]`` table, :class:`~tmem.vehicles.quadrotor_table.QuadrotorModelParams`.
     wind
         The scenario's ``[wind]`` table, :class:`~tmem.scenario.wind_table.WindParams` (default: none).
     """
@@ -243,7 +244,12 @@ class QuadrotorModel(VehicleModel):
     body_names = BODY_NAMES
     body_units = BODY_UNITS
     body_long_names = BODY_LONG_NAMES
-    step = step_quadrotor
+    table = QuadrotorModelParams
+
+    @classmethod
+    def kernel(cls):
+        """The compiled step :func:`step_quadrotor`."""
+        return step_quadrotor
 
     def __init__(self, params: Any, wind: Any = None):
         super().__init__(params)

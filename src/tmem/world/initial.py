@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tmem.vehicles import vehicle_class
 from tmem.world.formation import generate
 from tmem.scenario import Scenario
 
@@ -139,4 +140,5 @@ def build(scenario: Scenario) -> InitialArrays:
     box = np.asarray(scenario.space.box, dtype=float) if scenario.space.periodic else np.zeros(axes)
     if scenario.space.periodic:
         state[:, :, 0] %= box
+    state = vehicle_class(scenario.model.kind).initial_state(state)  # the vehicle's own per-axis state
     return InitialArrays(state, active, edges, d_ts, direction, flag, box)
