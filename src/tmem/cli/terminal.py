@@ -13,6 +13,9 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Column, Table
 from rich.text import Text
 
+from tmem.analysis.rms import SWINGS as swinging_note
+from tmem.analysis.rms import swings
+
 #: Runs expected to take less than this (s) show no progress bar.
 PROGRESS_AFTER = 1.0
 
@@ -57,7 +60,7 @@ def _number(value: float | None, form: str) -> str:
 
 
 #: Under the table when a run ended with pairs coupled and still oscillating.
-SWINGS = "* pairs still coupled and oscillating at the end: ΔRMS is an instantaneous value that swings with their oscillation"
+SWINGS = f"* {swinging_note}"
 #: The table's columns, after the run's name.
 HEADERS = ("function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "largest ΔRMS (%)", "min dist (m)")
 
@@ -69,18 +72,12 @@ def _coupled_cell(s: dict) -> str:
     return f"yes, {s['pairs_coupled_at_end']}/{len(s['pairs'])} at end"
 
 
-def _swings(s: dict) -> bool:
-    """Whether the run's ΔRMS swings with an oscillation still going on at the end (older summaries
-    have no ``rms_change_swings``: pairs coupled at the end then count as swinging)."""
-    return bool(s.get("rms_change_swings", s["rms_change_while_coupled"])) and s["rms_change_percent"] is not None
-
-
 def _cells(s: dict) -> list[str]:
     """The figures of one run, in the order of :data:`HEADERS`."""
     peak, at = s.get("rms_change_peak_percent"), s.get("rms_change_peak_time")
     return [
         s["function"], _coupled_cell(s), _number(s["couple_time"], "{:.2f}"), _number(s["uncouple_time"], "{:.2f}"),
-        _number(s["rms_change_percent"], "{:+.3f}") + (" *" if _swings(s) else ""),
+        _number(s["rms_change_percent"], "{:+.3f}") + (" *" if swings(s) else ""),
         "—" if peak is None else f"{peak:+.3f} at {at:.2f} s", _number(s["min_distance"], "{:.2f}"),
     ]  # fmt: skip
 
@@ -132,7 +129,7 @@ class RunsTable:
             for name, s in self.rows.items():
                 yield Text(name, style="bold")
                 yield Padding(_block(s), (0, 0, 1, 2))
-        if any(_swings(s) for s in self.rows.values()):
+        if any(swings(s) for s in self.rows.values()):
             yield Text(SWINGS)
 
 

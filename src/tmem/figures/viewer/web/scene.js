@@ -1,6 +1,7 @@
 // The swarm drawn with three.js: agents, interaction spheres (circles in 1-D and 2-D) of radius R,
 // formation edges coloured by strain, removed agents, the box and obstacles; orbit (3-D) or pan
-// (1-D, 2-D) and zoom; agent numbers and the agent under the pointer.
+// (1-D, 2-D) and zoom; agent numbers and the agent under the pointer; the axes: in 1-D and 2-D a
+// grid with its values along the edges of the view, in 3-D each axis named along the frame.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls';
 import { edgeQuads, STRAIN_COLOURS, strainColour } from 'tmem/edges';
@@ -31,6 +32,15 @@ const CROSS = () => sprite((g) => {
   g.lineWidth = 12;
   g.beginPath(); g.moveTo(10, 10); g.lineTo(54, 54); g.moveTo(54, 10); g.lineTo(10, 54); g.stroke();
 });
+
+// How the axes' texts sit on their point: x values centred on their grid line, y values beside theirs.
+const SHIFT = { 'tick x': ' translateX(-50%)', 'tick y': ' translateY(-50%)' };
+
+// A value as the axes write it: `digits` decimals, and 0 rather than -0.
+function formatted(value, digits = 0) {
+  const text = value.toFixed(digits);
+  return Number(text) === 0 ? (0).toFixed(digits) : text;
+}
 
 // A step of 1, 2 or 5 times a power of ten near `span`.
 export function niceStep(span) {
@@ -64,6 +74,9 @@ export class Scene {
     this.shownCount = 0;
     this.follow = false;
     this.labels = [];
+    this.axesLayer = document.createElement('div');
+    this.axesLayer.id = 'axes';
+    container.append(this.axesLayer);
     this.bounds = this.#bounds();
     this.#camera();
     this.#drawStatic();
@@ -129,13 +142,6 @@ export class Scene {
       const light = new THREE.DirectionalLight('#ffffff', 1.6);
       light.position.set(1, -1, 2);
       this.scene.add(light);
-    } else {
-      this.gridStep = niceStep((b.max.x - b.min.x) / 8);
-      const v = [];
-      const s = this.gridStep;
-      for (let x = Math.ceil(b.min.x / s) * s; x <= b.max.x; x += s) v.push(new THREE.Vector3(x, b.min.y, -1), new THREE.Vector3(x, b.max.y, -1));
-      for (let y = Math.ceil(b.min.y / s) * s; y <= b.max.y; y += s) v.push(new THREE.Vector3(b.min.x, y, -1), new THREE.Vector3(b.max.x, y, -1));
-      this.scene.add(lines(v, '#eeeeee'));
     }
     if (space.box) {
       const box = new THREE.Box3(new THREE.Vector3(), this.#point(space.box));
@@ -299,9 +305,7 @@ export class Scene {
 
   // Screen position (CSS px in the canvas) of agent column a at the frame shown.
   screen(a, out = new THREE.Vector3()) {
-    const { clientWidth: w, clientHeight: h } = this.renderer.domElement;
-    this.at(this.frame, a, out).project(this.camera);
-    return [(out.x + 1) / 2 * w, (1 - out.y) / 2 * h, out.z];
+    return this.#onScreen(this.at(this.frame, a, out));
   }
 
   // The agent column drawn nearest (x, y), within PICK_PX, or -1.
@@ -316,9 +320,86 @@ export class Scene {
   }
 
   render() {
+    if (this.run.D < 3) this.#grid();
     this.renderer.render(this.scene, this.camera);
     this.#placeLabels();
+    this.#placeAxes();
     this.onRender?.();
+  }
+
+  // The world rectangle the orthographic view (1-D, 2-D) shows, and the grid's step for it.
+  visible() {
+    const c = this.camera;
+    const halfW = (c.right - c.left) / 2 / c.zoom, halfH = (c.top - c.bottom) / 2 / c.zoom;
+    const area = { x0: c.position.x - halfW, x1: c.position.x + halfW, y0: c.position.y - halfH, y1: c.position.y + halfH };
+    return { ...area, step: niceStep((area.x1 - area.x0) / 8) };
+  }
+
+  // Grid lines at the step of the view shown, over three times its area, drawn again when the step
+  // changes or the view leaves that area.
+  #grid() {
+    const v = this.visible();
+    const g = this.gridArea;
+    if (g && g.step === v.step && v.x0 >= g.x0 && v.x1 <= g.x1 && v.y0 >= g.y0 && v.y1 <= g.y1) return;
+    const [w, h, s] = [v.x1 - v.x0, v.y1 - v.y0, v.step];
+    const area = { x0: v.x0 - w, x1: v.x1 + w, y0: v.y0 - h, y1: v.y1 + h, step: s };
+    const points = [];
+    for (let x = Math.ceil(area.x0 / s) * s; x <= area.x1; x += s) points.push(new THREE.Vector3(x, area.y0, -1), new THREE.Vector3(x, area.y1, -1));
+    for (let y = Math.ceil(area.y0 / s) * s; y <= area.y1; y += s) points.push(new THREE.Vector3(area.x0, y, -1), new THREE.Vector3(area.x1, y, -1));
+    if (this.gridLines) { this.scene.remove(this.gridLines); this.gridLines.geometry.dispose(); }
+    this.gridLines = lines(points, '#eeeeee');
+    this.scene.add(this.gridLines);
+    this.gridArea = area;
+  }
+
+  // The axes' text: in 1-D and 2-D the grid lines' values along the bottom (x) and left (y) edges of
+  // the view and the axes' names; in 3-D each axis's name and range at the middle of a frame edge.
+  #placeAxes() {
+    const { clientWidth: w, clientHeight: h } = this.container;
+    const texts = [];
+    if (this.run.D === 3) {
+      const { min, max } = this.bounds;
+      const p = new THREE.Vector3();
+      this.run.axes.forEach((name, k) => {
+        p.copy(min).setComponent(k, (min.getComponent(k) + max.getComponent(k)) / 2);
+        const [x, y, z] = this.#onScreen(p);
+        const range = `${name}, m: ${formatted(min.getComponent(k))} to ${formatted(max.getComponent(k))}`;
+        if (z < 1) texts.push({ axis: name, value: null, text: range, x, y, cls: 'axis-name' });
+      });
+    } else {
+      const v = this.visible();
+      const digits = Math.max(0, -Math.floor(Math.log10(v.step)));
+      const ticks = (axis, low, high, place) => {
+        for (let k = Math.ceil(low / v.step); k * v.step <= high; k++) {
+          const value = k * v.step;
+          texts.push({ axis, value, text: formatted(value, digits), ...place(value), cls: `tick ${axis}` });
+        }
+      };
+      ticks('x', v.x0, v.x1, (value) => ({ x: (value - v.x0) / (v.x1 - v.x0) * w, y: h - 16 }));
+      texts.push({ axis: 'x', value: null, text: 'x, m', x: w - 34, y: h - 32, cls: 'axis-name' });
+      if (this.run.D === 2) {
+        ticks('y', v.y0, v.y1, (value) => ({ x: 3, y: (v.y1 - value) / (v.y1 - v.y0) * h }));
+        texts.push({ axis: 'y', value: null, text: 'y, m', x: 3, y: 4, cls: 'axis-name' });
+      }
+    }
+    this.axisTexts = texts;
+    const pool = this.axesLayer.children;
+    while (pool.length < texts.length) this.axesLayer.append(document.createElement('div'));
+    Array.from(pool).forEach((div, k) => {
+      div.hidden = k >= texts.length;
+      if (div.hidden) return;
+      const t = texts[k];
+      div.className = t.cls;
+      div.textContent = t.text;
+      div.style.transform = `translate(${t.x}px, ${t.y}px)${SHIFT[t.cls] ?? ''}`;
+    });
+  }
+
+  // Screen position (CSS px in the canvas) and depth of world point p.
+  #onScreen(p) {
+    const { clientWidth: w, clientHeight: h } = this.renderer.domElement;
+    const q = p.clone().project(this.camera);
+    return [(q.x + 1) / 2 * w, (1 - q.y) / 2 * h, q.z];
   }
 
   #placeLabels() {
