@@ -223,3 +223,29 @@ def test_paths_in_a_periodic_box_break_where_they_wrap_and_cover_the_box():
     cells = np.floor(np.array(starts) / (box / 4)).astype(int)
     assert len({tuple(c) for c in cells}) == 16  # every quarter of every side
     assert position[0, :100, 1].max() < box[1] / 2  # the first 100 numbered would not have been
+
+
+def test_every_label_of_a_3d_view_lies_inside_its_own_panel(triangle_3d):
+    """shape.png's four 3-D views side by side, paths.png's beside its projection and the animation's:
+    each view's x, y and z labels are drawn inside its panel, where the next panel cannot cover them."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from tmem.figures.animate.frames import read_frames
+    from tmem.figures.animate.scene import positions, scene
+
+    trajectory, out = triangle_3d
+    frames = read_frames(out, max_frames=10)
+    figures = [figures_of(trajectory)[name](trajectory) for name in ("shape.png", "paths.png")]
+    figures.append(scene(frames, positions(frames)[0], dpi=100)[0])
+    for fig in figures:
+        FigureCanvasAgg(fig)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        views = [ax for ax in fig.axes if ax.name == "3d"]
+        assert views
+        for ax in views:
+            panel = ax.get_window_extent(renderer)
+            for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+                label = axis.label.get_window_extent(renderer)
+                assert axis.label.get_text().endswith(", m")
+                assert panel.x0 <= label.x0 and label.x1 <= panel.x1 and panel.y0 <= label.y0 and label.y1 <= panel.y1, axis.label.get_text()

@@ -23,6 +23,8 @@ Positions are drawn as recorded; in a periodic box, a pair across the box's edge
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
@@ -33,7 +35,9 @@ from tmem.figures.drawing import (
     MAX_LEGEND, MAX_NUMBERED, STRAIN_LABEL, agent_colors, agent_label, agents_legend, columns_of, draw_region, run_title,
     spread_agents, strain, strain_colormap, strain_limit, strain_norm,
 )  # fmt: skip
-from tmem.engine import Trajectory
+
+if TYPE_CHECKING:  # the animation draws its 3-D view with space_view, without the engine
+    from tmem.engine import Trajectory
 
 #: Most moments drawn in ``shape.png``.
 MAX_MOMENTS = 4
@@ -72,11 +76,27 @@ def _plane(ax, trajectory: Trajectory, low: np.ndarray, high: np.ndarray) -> Non
     draw_region(ax, scenario.space.box, scenario.space.walls, [(o.center, o.radius) for o in scenario.obstacles])
 
 
-def _space(ax, low: np.ndarray, high: np.ndarray) -> None:
-    """A 3-D view: limits, equal scale, labels."""
-    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]), xlabel="x, m", ylabel="y, m")
-    ax.set_zlabel("z, m")
+#: How much of its panel a 3-D view's box fills: less than matplotlib's 1, so that the axes' labels
+#: fall inside the panel, not under the next one (the layout does not make room for them).
+SPACE_ZOOM = 0.7
+
+
+def space_view(ax, low: np.ndarray, high: np.ndarray) -> None:
+    """Set up a 3-D view: limits, equal scale, labels clear of the tick values, all inside its panel.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes3D
+        The view.
+    low, high : ndarray, shape (3,)
+        The corners of the space shown (m).
+    """
+    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+    for axis, name in zip((ax.xaxis, ax.yaxis, ax.zaxis), "xyz"):
+        axis.set_label_text(f"{name}, m")
+        axis.labelpad = 10
     ax.set_aspect("equal")
+    ax.set_box_aspect(None, zoom=SPACE_ZOOM)
 
 
 def _number(ax, trajectory: Trajectory, points: np.ndarray, columns: np.ndarray) -> None:
@@ -154,7 +174,7 @@ def paths_figure(trajectory: Trajectory):
         views = [ax]
         if n_axes == 3:
             views.append(fig.add_subplot(1, 2, 1, projection="3d"))
-            _space(views[1], low, high)
+            space_view(views[1], low, high)
             ax.set_title("projection on (x, y)")
         starts = _flying_end(flying, first=True)
         ends = _flying_end(flying, first=False)
@@ -263,7 +283,7 @@ def shape_figure(trajectory: Trajectory):
     for k, ((name, record), (low, high)) in enumerate(zip(shown, windows)):
         ax = fig.add_subplot(1, len(shown), k + 1, projection="3d" if n_axes == 3 else None, label=name)
         if n_axes == 3:
-            _space(ax, low, high)
+            space_view(ax, low, high)
         else:
             _plane(ax, trajectory, low, high)
         _draw_moment(ax, trajectory, (name, record), pairs, norm, colors)

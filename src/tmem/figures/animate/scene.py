@@ -17,6 +17,7 @@ from matplotlib.lines import Line2D
 
 from tmem.figures.drawing import MAX_NUMBERED, STRAIN_LABEL, draw_region, strain, strain_colormap, strain_limit, strain_norm
 from tmem.figures.animate.frames import Frames
+from tmem.figures.shape_plot import space_view
 
 #: Most agents drawn with their interaction circles.
 MAX_CIRCLES = 2000
@@ -94,9 +95,7 @@ def _views(run: Frames, shown: np.ndarray, dpi: int) -> tuple[Figure, object, ob
     plane.grid(alpha=0.3)
     draw_region(plane, run.box, run.box is not None, run.obstacles)
     if space is not None:
-        space.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]), xlabel="x, m", ylabel="y, m")
-        space.set_zlabel("z, m")
-        space.set_aspect("equal")
+        space_view(space, low, high)
         plane.set_title("projection on (x, y)")
     drawn = f"{len(run.agents)} agents" if not run.agents_note else run.agents_note
     fig.suptitle(f"{run.name + ': ' if run.name else ''}{drawn}, R = {run.radius:g} m", parse_math=False)
