@@ -31,6 +31,7 @@ MODULES = {
     "three/addons/OrbitControls": ("vendor", "OrbitControls.js"),
     "tmem/run": ("web", "run.js"),
     "tmem/edges": ("web", "edges.js"),
+    "tmem/axes": ("web", "axes.js"),
     "tmem/scene": ("web", "scene.js"),
     "tmem/charts": ("web", "charts.js"),
     "tmem/main": ("web", "main.js"),

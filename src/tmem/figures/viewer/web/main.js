@@ -3,7 +3,8 @@
 import { decode, frameAt, FLYING, REMOVED } from 'tmem/run';
 import { Charts } from 'tmem/charts';
 import { WebGLRenderer } from 'three';
-import { COLOURS, niceStep, Scene } from 'tmem/scene';
+import { COLOURS, Scene } from 'tmem/scene';
+import { niceStep } from 'tmem/axes';
 
 const $ = (id) => document.getElementById(id);
 const timing = { scripts: performance.now() }; // ms from the start of navigation

@@ -6,6 +6,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls';
 import { edgeQuads, STRAIN_COLOURS, strainColour } from 'tmem/edges';
 import { FLYING, REMOVED, WAITING } from 'tmem/run';
+import { axisTexts, gridArea, gridPoints, placeTexts, visibleArea } from 'tmem/axes';
 
 export const COLOURS = {
   agent: '#1f77b4', removed: '#7f7f7f', sphere: '#1f77b4', frame: '#b8b8b8', box: '#555555', obstacle: '#999999',
@@ -32,21 +33,6 @@ const CROSS = () => sprite((g) => {
   g.lineWidth = 12;
   g.beginPath(); g.moveTo(10, 10); g.lineTo(54, 54); g.moveTo(54, 10); g.lineTo(10, 54); g.stroke();
 });
-
-// How the axes' texts sit on their point: x values centred on their grid line, y values beside theirs.
-const SHIFT = { 'tick x': ' translateX(-50%)', 'tick y': ' translateY(-50%)' };
-
-// A value as the axes write it: `digits` decimals, and 0 rather than -0.
-function formatted(value, digits = 0) {
-  const text = value.toFixed(digits);
-  return Number(text) === 0 ? (0).toFixed(digits) : text;
-}
-
-// A step of 1, 2 or 5 times a power of ten near `span`.
-export function niceStep(span) {
-  const p = 10 ** Math.floor(Math.log10(span));
-  return [1, 2, 5, 10].map((m) => m * p).find((s) => s >= span) ?? 10 * p;
-}
 
 function points(count, size, texture, colour) {
   const geometry = new THREE.BufferGeometry();
@@ -328,71 +314,23 @@ export class Scene {
   }
 
   // The world rectangle the orthographic view (1-D, 2-D) shows, and the grid's step for it.
-  visible() {
-    const c = this.camera;
-    const halfW = (c.right - c.left) / 2 / c.zoom, halfH = (c.top - c.bottom) / 2 / c.zoom;
-    const area = { x0: c.position.x - halfW, x1: c.position.x + halfW, y0: c.position.y - halfH, y1: c.position.y + halfH };
-    return { ...area, step: niceStep((area.x1 - area.x0) / 8) };
-  }
+  visible() { return visibleArea(this.camera); }
 
   // Grid lines at the step of the view shown, over three times its area, drawn again when the step
   // changes or the view leaves that area.
   #grid() {
-    const v = this.visible();
-    const g = this.gridArea;
-    if (g && g.step === v.step && v.x0 >= g.x0 && v.x1 <= g.x1 && v.y0 >= g.y0 && v.y1 <= g.y1) return;
-    const [w, h, s] = [v.x1 - v.x0, v.y1 - v.y0, v.step];
-    const area = { x0: v.x0 - w, x1: v.x1 + w, y0: v.y0 - h, y1: v.y1 + h, step: s };
-    const points = [];
-    for (let x = Math.ceil(area.x0 / s) * s; x <= area.x1; x += s) points.push(new THREE.Vector3(x, area.y0, -1), new THREE.Vector3(x, area.y1, -1));
-    for (let y = Math.ceil(area.y0 / s) * s; y <= area.y1; y += s) points.push(new THREE.Vector3(area.x0, y, -1), new THREE.Vector3(area.x1, y, -1));
+    const area = gridArea(this.visible(), this.gridArea);
+    if (area === this.gridArea) return;
     if (this.gridLines) { this.scene.remove(this.gridLines); this.gridLines.geometry.dispose(); }
-    this.gridLines = lines(points, '#eeeeee');
+    this.gridLines = lines(gridPoints(area), '#eeeeee');
     this.scene.add(this.gridLines);
     this.gridArea = area;
   }
 
-  // The axes' text: in 1-D and 2-D the grid lines' values along the bottom (x) and left (y) edges of
-  // the view and the axes' names; in 3-D each axis's name and range at the middle of a frame edge.
   #placeAxes() {
     const { clientWidth: w, clientHeight: h } = this.container;
-    const texts = [];
-    if (this.run.D === 3) {
-      const { min, max } = this.bounds;
-      const p = new THREE.Vector3();
-      this.run.axes.forEach((name, k) => {
-        p.copy(min).setComponent(k, (min.getComponent(k) + max.getComponent(k)) / 2);
-        const [x, y, z] = this.#onScreen(p);
-        const range = `${name}, m: ${formatted(min.getComponent(k))} to ${formatted(max.getComponent(k))}`;
-        if (z < 1) texts.push({ axis: name, value: null, text: range, x, y, cls: 'axis-name' });
-      });
-    } else {
-      const v = this.visible();
-      const digits = Math.max(0, -Math.floor(Math.log10(v.step)));
-      const ticks = (axis, low, high, place) => {
-        for (let k = Math.ceil(low / v.step); k * v.step <= high; k++) {
-          const value = k * v.step;
-          texts.push({ axis, value, text: formatted(value, digits), ...place(value), cls: `tick ${axis}` });
-        }
-      };
-      ticks('x', v.x0, v.x1, (value) => ({ x: (value - v.x0) / (v.x1 - v.x0) * w, y: h - 16 }));
-      texts.push({ axis: 'x', value: null, text: 'x, m', x: w - 34, y: h - 32, cls: 'axis-name' });
-      if (this.run.D === 2) {
-        ticks('y', v.y0, v.y1, (value) => ({ x: 3, y: (v.y1 - value) / (v.y1 - v.y0) * h }));
-        texts.push({ axis: 'y', value: null, text: 'y, m', x: 3, y: 4, cls: 'axis-name' });
-      }
-    }
-    this.axisTexts = texts;
-    const pool = this.axesLayer.children;
-    while (pool.length < texts.length) this.axesLayer.append(document.createElement('div'));
-    Array.from(pool).forEach((div, k) => {
-      div.hidden = k >= texts.length;
-      if (div.hidden) return;
-      const t = texts[k];
-      div.className = t.cls;
-      div.textContent = t.text;
-      div.style.transform = `translate(${t.x}px, ${t.y}px)${SHIFT[t.cls] ?? ''}`;
-    });
+    this.axisTexts = axisTexts(this.run, this.bounds, this.visible(), w, h, (p) => this.#onScreen(p));
+    placeTexts(this.axesLayer, this.axisTexts);
   }
 
   // Screen position (CSS px in the canvas) and depth of world point p.
