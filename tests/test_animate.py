@@ -1,4 +1,4 @@
-"""Animation of a 2-D or 3-D run, from small synthetic ``trajectory.nc`` files."""
+"""Animation of a run on one axis, in the plane and in space, from small synthetic ``trajectory.nc`` files."""
 
 import subprocess
 import sys
@@ -92,12 +92,36 @@ def test_recorded_subset_maps_pairs_by_agent_index(tmp_path):
     assert len(_frames(animate(run, max_frames=10, dpi=40))) == 10
 
 
-def test_refuses_runs_on_one_axis(tmp_path):
+def test_a_run_on_one_axis_is_drawn_on_the_line(tmp_path):
+    """The paper's runs fly on one axis: each frame puts the agents at (x, 0), x as the file holds it."""
+    ds = _dataset(n_axes=1)
     run = _write(tmp_path, n_axes=1)
-    with pytest.raises(ValueError) as error:
-        animate(run)
-    assert str(error.value) == "animate: the run has 1 axis; only 2-D and 3-D runs can be animated"
-    assert not (run / "animation.gif").exists()
+    frames = read_frames(run, max_frames=400)
+    shown, cross = positions(frames)
+    fig, moving = scene(frames, shown, dpi=40)
+    assert [ax.name for ax in fig.axes].count("3d") == 0 and list(fig.axes[0].get_yticks()) == []
+    for f in (0, 17, 29):
+        update(moving, frames, f, shown, cross, True)
+        flying = ds["active"].values[:, f] == 1
+        expected = np.stack([ds["x"].values[:, f], np.zeros(3)], axis=-1)[flying]
+        np.testing.assert_array_equal(moving["dots"].get_offsets()[flying], expected)
+    assert len(_frames(animate(run, max_frames=10, dpi=40))) == 10
+
+
+def test_the_paper_s_run_can_be_animated_from_the_command_line(tmp_path):
+    """Fig. 9 (6 s of it) written as tmem run writes it, animated by the command."""
+    from typer.testing import CliRunner
+
+    import tmem
+    from tmem.cli.main import app
+    from tmem.files.io import write_run
+    from tmem.scenario import with_changes
+
+    scenario = with_changes(tmem.preset("fig9"), {"simulation.duration": 6.0, "simulation.dt": 0.001, "commands": []})
+    write_run(tmem.simulate(scenario), tmp_path / "fig9")
+    result = CliRunner().invoke(app, ["animate", str(tmp_path / "fig9"), "--max-frames", "8"])
+    assert result.exit_code == 0, result.output
+    assert len(_frames(tmp_path / "fig9" / "animation.gif")) == 8
 
 
 def test_3d_run_is_drawn_in_3d_beside_its_projection(tmp_path):

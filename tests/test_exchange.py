@@ -68,19 +68,66 @@ def gas3d(tmp_path_factory):
 # The attitude
 
 
-def test_the_attitude_is_pitch_phi_x_then_roll_minus_phi_y_with_no_yaw():
-    """Against SciPy's Z-Y-X Euler angles (yaw 0, pitch phi_x, roll -phi_y), for known tilts."""
-    phi_x = np.array([0.0, 0.1, -0.3, 0.0, 0.7, 0.05])
-    phi_y = np.array([0.0, 0.0, 0.2, -0.4, 0.0, 0.05])
+def _tilts_attitude(phi_x, phi_y):
+    """SciPy's rotation with yaw 0, pitch phi_x and the roll whose thrust axis has the tilt phi_y,
+    ``atan2(b_3y, b_3z)``, as ``(qw, qx, qy, qz)``."""
+    roll = -np.arctan(np.tan(phi_y) * np.cos(phi_x))
+    euler = np.stack([np.zeros_like(phi_x), phi_x, roll], axis=-1)
+    return Rotation.from_euler("ZYX", euler).as_quat()[..., [3, 0, 1, 2]]  # SciPy writes (x, y, z, w)
+
+
+def test_the_attitude_has_the_tilts_the_quadrotor_reads_and_no_yaw():
+    """The tilts defined as in docs/vehicles.md, atan2(b_3a, b_3z) of the thrust axis, read back from
+    SciPy's rotation of e_z; yaw 0; the same quaternion as the quadrotor's own start from tilts."""
+    from tmem.vehicles.quadrotor import attitude_of_tilts
+
+    phi_x = np.array([0.0, 0.1, -0.3, 0.0, 0.7, 0.05, 0.4])
+    phi_y = np.array([0.0, 0.0, 0.2, -0.4, 0.0, 0.05, -0.6])
     q = attitude_quaternion(phi_x, phi_y)
-    expected = Rotation.from_euler("ZYX", np.stack([np.zeros_like(phi_x), phi_x, -phi_y], axis=-1)).as_quat()
-    np.testing.assert_allclose(q, expected[:, [3, 0, 1, 2]], atol=1e-15)  # SciPy writes (x, y, z, w)
     assert np.all(q[:, 0] > 0)
-    # The thrust axis leans the way the model (2) accelerates: +x for phi_x > 0, +y for phi_y > 0.
-    thrust = Rotation.from_quat(q[:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])
-    np.testing.assert_allclose(thrust[:, 0], np.sin(phi_x) * np.cos(phi_y), atol=1e-15)
-    np.testing.assert_allclose(thrust[:, 1], np.sin(phi_y), atol=1e-15)
-    np.testing.assert_allclose(Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_euler("ZYX")[:, 0], 0.0, atol=1e-15)
+    rotation = Rotation.from_quat(q[:, [1, 2, 3, 0]])
+    thrust = rotation.apply([0.0, 0.0, 1.0])
+    np.testing.assert_allclose(np.arctan2(thrust[:, 0], thrust[:, 2]), phi_x, atol=1e-15)
+    np.testing.assert_allclose(np.arctan2(thrust[:, 1], thrust[:, 2]), phi_y, atol=1e-15)
+    np.testing.assert_allclose(rotation.as_euler("ZYX")[:, 0], 0.0, atol=1e-15)
+    quadrotor = np.array([attitude_of_tilts(x, y) for x, y in zip(phi_x, phi_y)])[:, [3, 0, 1, 2]]
+    np.testing.assert_allclose(q, quadrotor, atol=1e-15)
+
+
+@pytest.fixture(scope="module")
+def quadrotor_run(tmp_path_factory):
+    """The triangle flown by quadrotors (they record their body attitude), written as ``tmem run`` does."""
+    text = TRIANGLE.replace("[space]", '[model]\nkind = "quadrotor"\n[space]')
+    trajectory = tmem.simulate(tmem.loads(text))
+    out = tmp_path_factory.mktemp("export") / "quadrotor"
+    write_run(trajectory, out)
+    return out, trajectory
+
+
+def _recorded_attitude(trajectory, k):
+    """Agent ``k``'s quaternion as the run recorded it, ``(qw, qx, qy, qz)`` with qw > 0."""
+    from tmem.vehicles.quadrotor import BODY_NAMES
+
+    q = trajectory.body[:, k][:, [BODY_NAMES.index(n) for n in ("q_w", "q_x", "q_y", "q_z")]]
+    return q * np.sign(q[:, :1]) / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def test_a_quadrotor_exports_the_attitude_it_recorded(quadrotor_run, tmp_path):
+    """CSV and MCAP carry the recorded body quaternion, not one rebuilt from the tilts (which leaves out
+    the body's yaw and any difference in how the tilts were taken)."""
+    run_dir, trajectory = quadrotor_run
+    out = export(run_dir, "csv", tmp_path / "csv")
+    _, messages, = _read_mcap(export(run_dir, "mcap", tmp_path / "run.mcap"))[1:]
+    for k in range(3):
+        recorded = _recorded_attitude(trajectory, k)
+        _, table = _read_csv(out / f"agent{k + 1}.csv")
+        np.testing.assert_allclose(table[:, 4:], recorded, atol=1e-15)
+        turns = [next(e for e in scene.entities if e.id == f"agent{k + 1}").spheres[0].pose.orientation
+                 for _, scene in messages["/swarm"]]  # fmt: skip
+        np.testing.assert_allclose([[o.w, o.x, o.y, o.z] for o in turns], recorded, atol=1e-15)
+    # What was exported before: the tilts' attitude, off the recorded one by more than rounding.
+    tilts = trajectory.state[:, 0, :, 2]
+    assert np.abs(_tilts_attitude(tilts[:, 0], tilts[:, 1]) - _recorded_attitude(trajectory, 0)).max() > 1e-6
 
 
 # ----------------------------------------------------------------------------------------------
@@ -196,9 +243,7 @@ def test_csv_files_hold_positions_and_attitudes_numbered_from_1(triangle, tmp_pa
         np.testing.assert_array_equal(table[:, 1:3], trajectory.state[:, k, :, 0])  # the text reads back exactly
         assert np.all(table[:, 3] == 0.0)  # a 2-D run flies in the plane z = 0
         tilts = trajectory.state[:, k, :, 2]
-        euler = np.stack([np.zeros(len(tilts)), tilts[:, 0], -tilts[:, 1]], axis=-1)
-        expected = Rotation.from_euler("ZYX", euler).as_quat()[:, [3, 0, 1, 2]]
-        np.testing.assert_allclose(table[:, 4:], expected, atol=1e-15)
+        np.testing.assert_allclose(table[:, 4:], _tilts_attitude(tilts[:, 0], tilts[:, 1]), atol=1e-15)
         assert np.abs(tilts).max() > 1e-3  # the tilts are not all zero: the comparison compares something
 
 

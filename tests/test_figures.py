@@ -197,3 +197,55 @@ def test_animation_numbers_every_agent_and_fits_its_strain_scale_to_the_run(hex1
     largest = float(abs((ds["distance"] / ds["d_t"] - 1).where(ds["F_en"] == 1)).max())
     assert moving["coupled"].norm.vmax == pytest.approx(largest, rel=1e-9)
     assert sorted(int(t.get_text()) for t in fig.axes[0].texts if t.get_text().isdigit()) == list(range(1, 20))
+
+
+def test_paths_in_a_periodic_box_break_where_they_wrap_and_cover_the_box():
+    """400 agents in a periodic box, 100 drawn: no line crosses the box (a step longer than half a side
+    on the recorded positions is a wrap, broken there, one break per wrap), and the agents drawn
+    start all over the box, not in the strip the first 100 numbered start in."""
+    scenario = with_changes(load(EXAMPLES / "swarm" / "gas_thermostat.toml"), {"simulation.duration": 20.0, "commands": []})
+    trajectory = tmem.simulate(scenario)
+    box = np.array(scenario.space.box)
+    ax = figures_of(trajectory)["paths.png"](trajectory).axes[0]
+    lines = labelled(ax, "agent ")
+    assert len(lines) == 100 and ax.figure.texts[0].get_text().endswith("100 of 400 agents: spread over where they started")
+    position = trajectory.model.position(trajectory.state)
+    starts = []
+    for label, line in lines.items():
+        xy, k = line.get_xydata(), int(label.split()[1]) - 1
+        wraps = int((np.abs(np.diff(position[:, k], axis=0)) > box / 2).any(axis=1).sum())
+        gaps = np.isnan(xy).any(axis=1)
+        assert gaps.sum() == wraps
+        steps = np.abs(np.diff(xy, axis=0))[~(gaps[1:] | gaps[:-1])]
+        assert (steps <= box / 2).all(), label  # no line across the box
+        np.testing.assert_array_equal(np.unique(xy[~gaps], axis=0), np.unique(position[:, k], axis=0))  # every record drawn
+        starts.append(position[0, k])
+    cells = np.floor(np.array(starts) / (box / 4)).astype(int)
+    assert len({tuple(c) for c in cells}) == 16  # every quarter of every side
+    assert position[0, :100, 1].max() < box[1] / 2  # the first 100 numbered would not have been
+
+
+def test_every_label_of_a_3d_view_lies_inside_its_own_panel(triangle_3d):
+    """shape.png's four 3-D views side by side, paths.png's beside its projection and the animation's:
+    each view's x, y and z labels are drawn inside its panel, where the next panel cannot cover them."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from tmem.figures.animate.frames import read_frames
+    from tmem.figures.animate.scene import positions, scene
+
+    trajectory, out = triangle_3d
+    frames = read_frames(out, max_frames=10)
+    figures = [figures_of(trajectory)[name](trajectory) for name in ("shape.png", "paths.png")]
+    figures.append(scene(frames, positions(frames)[0], dpi=100)[0])
+    for fig in figures:
+        FigureCanvasAgg(fig)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        views = [ax for ax in fig.axes if ax.name == "3d"]
+        assert views
+        for ax in views:
+            panel = ax.get_window_extent(renderer)
+            for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+                label = axis.label.get_window_extent(renderer)
+                assert axis.label.get_text().endswith(", m")
+                assert panel.x0 <= label.x0 and label.x1 <= panel.x1 and panel.y0 <= label.y0 and label.y1 <= panel.y1, axis.label.get_text()

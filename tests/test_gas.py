@@ -19,6 +19,7 @@ from tmem.law.modal import interaction_point, modal_gains
 from tmem.engine.gas import TOTALS
 from tmem.law.interaction.kernels import evaluate
 from tmem.vehicles.linear import state_matrices
+from tmem.analysis.metrics import rms_velocity, summarize
 from tmem.analysis.observables import gas_summary, temperature
 from tmem.scenario import ScenarioError, from_dict
 
@@ -442,7 +443,7 @@ def test_the_walls_pressure_obeys_the_virial_theorem(obstacles):
     """1000 agents in a walled box, held at 2 m/s: the momentum the walls take per unit time and length
     (G2) equals the virial pressure (G1) plus the walls' range term (G3) within 1 %, and the bulk
     virial alone is within 5 % of it; with an obstacle in the middle too, whose pushes the virial
-    holds."""
+    holds.  The summary gives that sum and its agreement with (G2), over its own window too."""
     scenario = from_dict({
         "name": "box", "space": {"axes": 2, "walls": True, "box": [2242.0, 2242.0]}, "obstacles": obstacles,
         "interaction": {"function": "repulsion", "combine": "mean"},
@@ -455,6 +456,18 @@ def test_the_walls_pressure_obeys_the_virial_theorem(obstacles):
     assert gas["pressure_virial"] + gas["pressure_wall_range"] == pytest.approx(gas["pressure_walls"], rel=0.01)
     assert gas["pressure_virial"] == pytest.approx(gas["pressure_walls"], rel=0.05)
     assert gas["pressure_walls"] > 1.2 * gas["pressure_ideal"]  # the pushes add to the kinetic pressure
+    summary = summarize(tr)
+    # From 20 s (100 s), and over the summary's window, the second half (60 s): noisier, within 2 %.
+    for window, within in ((gas, 1.0), (summary["gas"], 2.0)):
+        assert window["pressure_virial_walls"] == pytest.approx(window["pressure_walls"], rel=within / 100)
+        assert window["pressure_agreement_percent"] == pytest.approx(
+            100 * ((window["pressure_virial"] + window["pressure_wall_range"]) / window["pressure_walls"] - 1), abs=1e-9)
+        assert abs(window["pressure_agreement_percent"]) < within
+    # The start-up transient, from the engine's totals, against the recorded states of every agent.
+    change = 100 * (rms_velocity(tr.model.velocity(tr.state), tr.active) / summary["rms_velocity_initial"] - 1)
+    k = np.argmax(np.abs(change))
+    assert summary["rms_change_peak_percent"] == pytest.approx(change[k], abs=1e-9)
+    assert summary["rms_change_peak_time"] == tr.time[k] and change[k] > 10.0  # the start's overlaps turn into speed
 
 
 def test_the_virial_takes_the_pushes_as_saturated_with_the_thermostat_on():
@@ -503,7 +516,7 @@ def test_free_agents_give_the_ideal_gas():
     assert tr.gas[-1, 4] == pytest.approx(30.0 * sum(1.0 + k for k in range(4)), rel=1e-9)
     assert gas["density"] == pytest.approx(4e-6)
     assert gas["pressure_virial"] == pytest.approx(speed2 / (2 * 1e6), rel=1e-9)
-    assert gas["pressure_walls"] is None
+    assert gas["pressure_walls"] is None and gas["pressure_virial_walls"] is None and gas["pressure_agreement_percent"] is None
 
 
 @pytest.mark.parametrize(

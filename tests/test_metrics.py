@@ -151,10 +151,79 @@ def test_table_marks_an_rms_change_taken_while_coupled():
     console.print(summary_table(rows))
     text = console.export_text()
     lines = {name: next(line for line in text.splitlines() if name in line) for name in rows}
-    assert "│ no " in lines["never"] and "yes, 1/1 at end" in lines["formation pair, coupled throughout"]
+    assert " no " in lines["never"] and "yes, 1/1 at end" in lines["formation pair, coupled throughout"]
     assert "yes, 0/1 at end" in lines["formation pair losing an agent"]
     assert " * " in lines["Table 2 pair, no command"] and " * " not in lines["Table 2 pair, uncoupled by command"]
-    assert SWINGS in text
+    # Coupled at the end but 1 m off d_t a record before: still oscillating, so marked.
+    assert " * " in lines["formation pair, coupled throughout"]
+    assert SWINGS in " ".join(text.split())
+
+
+def _held(n=40, swing=0.0):
+    """A formation pair coupled throughout, 1 s between records, at d_t = 35 m but for ``swing`` m
+    off it over the first 10 s."""
+    distance = np.full(n, 35.0)
+    distance[:10] += swing * np.sin(np.arange(10))
+    return summarize(started_coupled(made(list(distance), [1] * n, [], velocities=np.array([[-1.5, 3.0]] * n))))
+
+
+def test_a_pair_held_at_its_distance_does_not_swing():
+    """The settled pair's RMS change is not marked; one off by 0.5 m over its last 20 s is."""
+    assert _held()["rms_change_while_coupled"] is True and _held()["rms_change_swings"] is False
+    assert _held(swing=1.0)["rms_change_swings"] is False  # only in its first 10 s of 40
+    assert _held(n=25, swing=1.0)["rms_change_swings"] is True  # within its last 20 s
+
+
+def test_a_synchronised_formation_is_not_marked_as_swinging_in_the_table():
+    """The settled triangle (synchronised) holds its pairs within 0.1 m over its last 20 s: its ΔRMS is
+    a settled value, not marked; the same triangle unsynchronised keeps oscillating and is marked."""
+    from rich.console import Console
+
+    from tmem.cli.terminal import SWINGS, summary_table
+    from tmem.scenario import load, with_changes
+
+    settled = load(tmem.__path__[0] + "/../../examples/swarm/triangle_settled.toml")
+    runs = {"settled": settled, "free": with_changes(settled, {"interaction.synchronise": False})}
+    rows = {name: summarize(tmem.simulate(scenario)) for name, scenario in runs.items()}
+    for s in rows.values():  # independent of the summary: the recorded distances over the last 20 s
+        assert s["rms_change_while_coupled"] is True
+    assert rows["settled"]["rms_change_swings"] is False and rows["free"]["rms_change_swings"] is True
+    console = Console(width=300, record=True)
+    console.print(summary_table({"settled": rows["settled"]}))
+    assert " * " not in console.export_text() and SWINGS not in " ".join(console.export_text().split())
+    console.print(summary_table(rows))
+    assert SWINGS in " ".join(console.export_text().split())
+
+
+@pytest.mark.parametrize("width", [60, 80, 100, 300])
+def test_the_table_never_folds_a_name_or_a_number(width):
+    """On any terminal width, every run's name and every figure is printed whole on one line."""
+    from rich.console import Console
+
+    from tmem.cli.terminal import summary_table
+
+    tr = made([50, 36, 33, 36], [0, 1, 1, 1], [Event(1.0, "couple", (0, 1))], velocities=np.array([[-1.5, 3.0]] * 4))
+    s = summarize(tr)
+    names = ["hex19-settled", "gas-box in a walled box, thermostat at 2 m/s", "fig9-energy"]
+    console = Console(width=width, record=True)
+    console.print(summary_table({name: s for name in names}))
+    lines = console.export_text().splitlines()
+    assert all(len(line.rstrip()) <= width for line in lines)
+    for text in [*names, "yes, 1/1 at end", f"{s['rms_change_percent']:+.3f} *", "largest ΔRMS (%)"]:
+        assert sum(text in line for line in lines) >= 1, (text, width)
+
+
+def test_summary_gives_the_largest_rms_change_on_the_way_and_when():
+    """Speeds known by construction: Table 2's start (RMS 2.37 m/s), then both agents at 3.0, 1.2, 2.5 m/s."""
+    start = np.sqrt((1.5**2 + 3.0**2) / 2)
+    speeds = np.array([start, 3.0, 1.2, 2.5])
+    velocities = np.column_stack([speeds, -speeds])
+    velocities[0] = (-1.5, 3.0)
+    tr = made([50, 50, 50, 50], [0, 0, 0, 0], [], velocities=velocities)
+    s = summarize(tr)
+    changes = 100 * (speeds / start - 1)  # +26.5 %, -49.4 %, +5.4 %
+    assert s["rms_change_peak_percent"] == pytest.approx(changes[2]) and s["rms_change_peak_time"] == 2.0
+    assert s["rms_change_percent"] == pytest.approx(changes[3])
 
 
 @pytest.mark.parametrize("kind, n", [("triangle", None), ("chain", 4), ("ring", 6)])

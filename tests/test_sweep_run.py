@@ -309,3 +309,29 @@ def test_a_local_cluster_that_does_not_close_in_time_leaves_no_worker(monkeypatc
         assert set(multiprocessing.active_children()) - before  # the worker's process
         monkeypatch.setattr(Local, "close", times_out)
     assert set(multiprocessing.active_children()) <= before
+
+
+@pytest.mark.parametrize("count", [3, 12, 25])
+def test_the_scatter_plot_tells_every_setting_apart_and_hides_no_point(count):
+    """Twelve or twenty-five settings: no two share a colour and marker; the legend lies beside the axes."""
+    from matplotlib.colors import to_rgba
+
+    from tmem.sweep.report import scatter_figure
+
+    rng = np.random.default_rng(1)
+    groups = [(f"interaction.c_max = {0.01 * (k + 1):.2f}",
+               pd.DataFrame({"x": rng.uniform(0, 1, 50), "rms_change_percent": rng.normal(k, 1, 50), "error": None}))
+              for k in range(count)]  # fmt: skip
+    fig = scatter_figure(groups, "x")
+    ax = fig.axes[0]
+    styles = set()
+    for collection in ax.collections:
+        colour = tuple(np.round(to_rgba(collection.get_facecolor()[0], 1.0), 6))
+        marker = collection.get_paths()[0].vertices.round(6).tobytes()
+        styles.add((colour, marker))
+    assert len(styles) == count
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legend, axes = ax.get_legend().get_window_extent(renderer), ax.get_window_extent(renderer)
+    assert legend.x0 >= axes.x1  # beside the plot, over none of its points
+    assert fig.bbox.x0 <= legend.x0 and legend.x1 <= fig.bbox.x1 + 1

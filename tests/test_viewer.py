@@ -27,7 +27,7 @@ from tmem.figures.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FR
 from tmem.figures.viewer import data
 from tmem.figures.viewer.page import VIEW_MARK, headline, quantised
 
-VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
+VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "figures" / "viewer" / "vendor"
 
 
 def scenario_text(n_agents: int, n_axes: int, name: str = "synthetic") -> str:
@@ -272,8 +272,24 @@ def test_the_headline_shows_the_summary_and_a_dash_for_what_is_missing():
     summary = {"agents": 19, "function": "improved", "duration": 60.0, "rms_change_percent": None,
                "min_distance": 33.076, "pairs_coupled_at_end": 40, "pairs": [{}] * 42}  # fmt: skip
     assert dict(headline(summary)) == {"agents": "19", "function": "improved", "duration": "60 s", "ΔRMS": "—",
-                                       "min distance": "33.08 m", "pairs coupled at end": "40/42"}  # fmt: skip
-    assert dict(headline({"agents": True})) == {"agents": "—", "function": "—", "duration": "—", "ΔRMS": "—", "min distance": "—"}
+                                       "largest ΔRMS": "—", "min distance": "33.08 m", "pairs coupled at end": "40/42"}  # fmt: skip
+    assert dict(headline({"agents": True})) == {"agents": "—", "function": "—", "duration": "—", "ΔRMS": "—",
+                                                "largest ΔRMS": "—", "min distance": "—"}  # fmt: skip
+
+
+def test_the_headline_marks_a_swinging_rms_change_and_says_why_as_the_table_does():
+    """Pairs coupled and oscillating at the end: ΔRMS marked and the table's caveat shown; pairs held
+    still (a settled formation): neither.  The largest change on the way is shown with its time."""
+    from tmem.cli.terminal import SWINGS as TABLE_SWINGS
+    from tmem.figures.viewer.page import caveat
+
+    summary = {"rms_change_percent": 2.26, "rms_change_while_coupled": True, "rms_change_swings": True,
+               "rms_change_peak_percent": -28.9, "rms_change_peak_time": 5.0}  # fmt: skip
+    shown = dict(headline(summary))
+    assert shown["ΔRMS"] == "+2.260 % *" and shown["largest ΔRMS"] == "-28.900 % at 5.00 s"
+    assert caveat(summary) == TABLE_SWINGS
+    settled = summary | {"rms_change_swings": False}
+    assert dict(headline(settled))["ΔRMS"] == "+2.260 %" and caveat(settled) == ""
 
 
 def test_a_name_with_markup_is_shown_as_written(tmp_path):

@@ -301,3 +301,61 @@ def test_a_thinned_page_says_what_it_shows(open_view, runs, tmp_path):
         "Shown: 50 of 300 agents, evenly chosen by number; 40 of 601 recorded times, evenly spaced."
     )
     assert len(viewer.drawn()) == 50
+
+
+def tick_scale(axes: list[dict], axis: str) -> tuple[float, float]:
+    """Pixels per metre and the pixel of 0 on ``axis``, fitted to the values the page writes along it."""
+    ticks = [(t["value"], t["x"] if axis == "x" else t["y"]) for t in axes if t["axis"] == axis and t["value"] is not None]
+    assert len(ticks) >= 3, (axis, ticks)
+    values, pixels = np.array(ticks).T
+    slope, offset = np.polyfit(values, pixels, 1)
+    assert np.abs(slope * values + offset - pixels).max() < 0.01  # evenly spaced, one scale
+    return slope, offset
+
+
+def assert_ticks_read_the_agents(viewer, axes_shown: str):
+    """Each agent's place on the screen, read off the axes' values, is its position in the file."""
+    axes = viewer.js("tmemViewer.axes()")
+    names = {t["text"] for t in axes if t["value"] is None}
+    assert names == {f"{a}, m" for a in axes_shown}
+    for k, axis in enumerate(axes_shown):
+        slope, offset = tick_scale(axes, axis)
+        world = np.array([a["position"][k] for a in viewer.drawn()])
+        np.testing.assert_allclose(slope * world + offset, viewer.screen()[:, k], atol=1.0)  # within a pixel
+        assert (slope > 0) == (axis == "x")  # y grows up the screen
+
+
+def test_the_plane_view_has_its_axes_values_and_names_and_they_follow_a_zoom(open_view, runs, tmp_path):
+    viewer = open_view(write_view(runs("hex19"), tmp_path / "hex19.html"))
+    assert_ticks_read_the_agents(viewer, "xy")
+    step = np.diff(sorted(t["value"] for t in viewer.js("tmemViewer.axes()") if t["axis"] == "x" and t["value"] is not None))
+    box = viewer.page.locator("#view canvas").bounding_box()
+    viewer.page.mouse.move(box["x"] + box["width"] / 3, box["y"] + box["height"] / 2)
+    for _ in range(6):  # zoom in, about 4 times
+        viewer.page.mouse.wheel(0, -600)
+        viewer.page.wait_for_timeout(100)
+    assert_ticks_read_the_agents(viewer, "xy")
+    zoomed = np.diff(sorted(t["value"] for t in viewer.js("tmemViewer.axes()") if t["axis"] == "x" and t["value"] is not None))
+    assert zoomed[0] < step[0]  # finer values once zoomed in
+    # The hex is left oscillating: its ΔRMS is marked, and the page says why, as the printed table does.
+    assert viewer.page.is_visible("#caveat") and "swings with their oscillation" in viewer.page.inner_text("#caveat")
+
+
+def test_the_line_view_has_its_x_values(open_view, runs, tmp_path):
+    viewer = open_view(write_view(runs("fig9"), tmp_path / "fig9.html"))
+    assert_ticks_read_the_agents(viewer, "x")
+    assert not viewer.page.is_visible("#caveat")  # the pair uncoupled before the end
+
+
+def test_the_3d_view_names_each_axis_with_its_range(open_view, runs, tmp_path):
+    run = runs("gas3d")
+    viewer = open_view(write_view(run, tmp_path / "gas3d.html"))
+    texts = {t["axis"]: t["text"] for t in viewer.js("tmemViewer.axes()")}
+    scenario = load(ROOT / "examples" / "swarm" / "gas3d.toml")
+    radius, box = scenario.interaction.radius, scenario.space.box
+    with open_file(run) as ds:
+        positions = file_positions(ds)
+    for k, axis in enumerate("xyz"):
+        low = min(positions[..., k].min(), 0.0) - radius  # the page's frame: every position and the box, R beyond
+        high = max(positions[..., k].max(), box[k]) + radius
+        assert texts[axis] == f"{axis}, m: {low:.0f} to {high:.0f}"

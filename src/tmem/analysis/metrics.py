@@ -1,8 +1,7 @@
-"""What a run measured: RMS velocity, distances, coupling events, formation errors.
+"""What a run measured: RMS velocity (:mod:`tmem.analysis.rms`), distances, coupling events,
+formation errors.
 
-The swarm's "temperature" in TMEM is its RMS velocity,
-``sqrt(mean_i |v_i|^2)`` over the agents flying; an encounter that keeps it
-is lossless in the thermal-motion sense.  A formation is judged per pair by
+A formation is judged per pair by
 its distance error ``|P_j - P_i| - d_t`` (and, where a direction is held, the
 angle to it), over the recorded samples.
 """
@@ -14,21 +13,7 @@ import numpy as np
 from tmem.engine import Event, Trajectory
 from tmem.analysis.coverage import coverage_summary
 from tmem.analysis.observables import gas_summary
-
-
-def rms_velocity(velocity: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
-    """RMS velocity over agents, ``sqrt(mean_i sum_axes v_i^2)``, counting only ``active`` agents.
-
-    Parameters
-    ----------
-    velocity : ndarray, shape (..., agents, axes)
-    active : ndarray, shape (..., agents), bool, optional
-    """
-    speed2 = np.sum(velocity**2, axis=-1)
-    if active is None:
-        return np.sqrt(np.mean(speed2, axis=-1))
-    count = np.sum(active, axis=-1)
-    return np.sqrt(np.sum(np.where(active, speed2, 0.0), axis=-1) / np.maximum(count, 1))
+from tmem.analysis.rms import rms_summary, rms_velocity  # noqa: F401  (rms_velocity: read from here too)
 
 
 def nearest_distance(positions: np.ndarray, active: np.ndarray, box: np.ndarray) -> float | None:
@@ -229,6 +214,27 @@ def settling(trajectory: Trajectory, band: float = SETTLE_BAND) -> dict:
     }
 
 
+def held_still(trajectory: Trajectory, band: float = SETTLE_BAND) -> bool:
+    """Whether every pair coupled over the run's last :data:`LAST_WINDOW` s (the whole run if it is
+    shorter) stayed within ``band`` of its ``d_t`` all that time, none coupling in it: their
+    oscillation has died out, and the RMS velocity no longer swings with it.
+
+    A pair passing through ``d_t`` in mid-swing is within the band for a moment only, and one that
+    has just coupled is within it at first: neither counts as held.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run (:func:`tmem.simulate`) with at least one record.
+    band : float
+        The band around ``d_t`` (m).
+    """
+    settled_at = settling(trajectory, band)["settling_time"]
+    window = max(float(trajectory.time[0]), float(trajectory.time[-1]) - LAST_WINDOW)
+    late_couple = any(e.kind == "couple" and e.time >= window for e in trajectory.events)
+    return settled_at is not None and settled_at <= window and not late_couple
+
+
 def direction_error_deg(trajectory: Trajectory) -> float | None:
     """Largest angle (degrees) between a recorded pair's direction and the one it must hold.
 
@@ -273,41 +279,6 @@ def summarize_events(events: list[Event]) -> list[dict]:
     return rows
 
 
-def _flying_rms(velocity: np.ndarray, active: np.ndarray) -> float | None:
-    """RMS velocity of the flying agents, ``None`` when none flies (an RMS over no agent is undefined)."""
-    return float(rms_velocity(velocity, active)) if np.any(active) else None
-
-
-def rms_summary(trajectory: Trajectory, pairs_coupled_at_end: int) -> dict:
-    """The RMS velocity at the start and the end, its change in %, and whether that change swings.
-
-    ``rms_change_percent`` is ``100 (rms_final / rms_initial - 1)``, each an
-    instantaneous value over the agents flying then (the measure of the
-    paper's Figs. 7 and 9).  While pairs are still coupled at the end, their
-    undamped oscillation trades speed for tilt and back, so this value swings
-    with the phase at which the run stops: ``rms_change_while_coupled`` is then
-    true.  ``None`` (JSON ``null``) where a value is undefined: no agent flying
-    at that time, or an initial RMS of 0.
-
-    Parameters
-    ----------
-    trajectory : Trajectory
-        A run (:func:`tmem.simulate`).
-    pairs_coupled_at_end : int
-        How many pairs are coupled at the end (:func:`coupling_states`).
-    """
-    model = trajectory.model
-    initial = _flying_rms(model.velocity(trajectory.initial.state), trajectory.initial.active)
-    final = _flying_rms(model.velocity(trajectory.final_state), trajectory.final_active)
-    defined = initial is not None and final is not None and initial > 0
-    return {
-        "rms_velocity_initial": initial,
-        "rms_velocity_final": final,
-        "rms_change_percent": 100.0 * (final / initial - 1.0) if defined else None,
-        "rms_change_while_coupled": pairs_coupled_at_end > 0,
-    }
-
-
 def coupling_summary(trajectory: Trajectory) -> dict:
     """Whether and when pairs were coupled, as written to ``summary.json``.
 
@@ -340,7 +311,8 @@ def coupling_summary(trajectory: Trajectory) -> dict:
 def summarize(trajectory: Trajectory) -> dict:
     """The run's summary, as written to ``summary.json``.
 
-    The RMS velocity and its change: :func:`rms_summary`; coupling:
+    The RMS velocity, its change and its largest change on the way:
+    :func:`tmem.analysis.rms.rms_summary`; coupling:
     :func:`coupling_summary`; the gas's observables (when observed):
     :func:`tmem.analysis.observables.gas_summary`; the coverage of a walled box:
     :func:`~tmem.analysis.coverage.runs.coverage_summary`.  ``min_distance`` is the smallest distance two
@@ -357,6 +329,7 @@ def summarize(trajectory: Trajectory) -> dict:
     scenario = trajectory.scenario
     model = trajectory.model
     coupling = coupling_summary(trajectory)
+    settled = len(trajectory.time) > 0 and held_still(trajectory)
     min_pairs = float(trajectory.min_distance.min()) if len(trajectory.min_distance) else np.inf
     final_position = model.position(trajectory.final_state)
     return {
@@ -366,7 +339,7 @@ def summarize(trajectory: Trajectory) -> dict:
         "axes": scenario.space.axes,
         "dt": scenario.simulation.dt,
         "duration": scenario.simulation.duration,
-        **rms_summary(trajectory, coupling["pairs_coupled_at_end"]),
+        **rms_summary(trajectory, coupling["pairs_coupled_at_end"], settled),
         "min_distance": _finite(min(min_pairs, trajectory.min_neighbor_distance)),
         "final_distance": nearest_distance(final_position, trajectory.final_active, trajectory.initial.box),
         **coupling,

@@ -1,14 +1,20 @@
 """What the ``tmem`` command prints to a terminal: a progress bar that appears only for long runs,
-and the runs' headline figures as a table."""
+and the runs' headline figures as a table that fits the terminal: one row per run, or, on a terminal
+too narrow for that, one block of rows per run, so that names and numbers are never folded."""
 
 from __future__ import annotations
 
 import time
 
+from rich import box
 from rich.console import Console
+from rich.padding import Padding
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Column, Table
 from rich.text import Text
+
+from tmem.analysis.rms import SWINGS as swinging_note
+from tmem.analysis.rms import swings
 
 #: Runs expected to take less than this (s) show no progress bar.
 PROGRESS_AFTER = 1.0
@@ -53,8 +59,10 @@ def _number(value: float | None, form: str) -> str:
     return "—" if value is None else form.format(value)
 
 
-#: Under the table when a run ended with pairs coupled.
-SWINGS = "* pairs still coupled at the end: ΔRMS is an instantaneous value that swings with their oscillation"
+#: Under the table when a run ended with pairs coupled and still oscillating.
+SWINGS = f"* {swinging_note}"
+#: The table's columns, after the run's name.
+HEADERS = ("function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "largest ΔRMS (%)", "min dist (m)")
 
 
 def _coupled_cell(s: dict) -> str:
@@ -64,23 +72,78 @@ def _coupled_cell(s: dict) -> str:
     return f"yes, {s['pairs_coupled_at_end']}/{len(s['pairs'])} at end"
 
 
-def summary_table(rows: dict[str, dict]) -> Table:
-    """The runs' headline figures, one row each; ΔRMS marked ``*`` where pairs were still coupled at the end.
+def _cells(s: dict) -> list[str]:
+    """The figures of one run, in the order of :data:`HEADERS`."""
+    peak, at = s.get("rms_change_peak_percent"), s.get("rms_change_peak_time")
+    return [
+        s["function"], _coupled_cell(s), _number(s["couple_time"], "{:.2f}"), _number(s["uncouple_time"], "{:.2f}"),
+        _number(s["rms_change_percent"], "{:+.3f}") + (" *" if swings(s) else ""),
+        "—" if peak is None else f"{peak:+.3f} at {at:.2f} s", _number(s["min_distance"], "{:.2f}"),
+    ]  # fmt: skip
+
+
+def _wide(rows: dict[str, dict]) -> Table:
+    """One row per run."""
+    table = Table(*(Column(h, no_wrap=True) for h in ("run", *HEADERS)), box=box.SIMPLE_HEAD, pad_edge=False)
+    for name, s in rows.items():
+        table.add_row(Text(name), *_cells(s))
+    return table
+
+
+def _block(s: dict) -> Table:
+    """One run's figures, one row each: (figure, value)."""
+    table = Table(Column(no_wrap=True), Column(no_wrap=True), box=None, pad_edge=False, show_header=False)
+    for header, cell in zip(HEADERS, _cells(s)):
+        table.add_row(header, cell)
+    return table
+
+
+class RunsTable:
+    """The runs' headline figures as the terminal shows them: one row each where the terminal is wide
+    enough, else each run's name on a line of its own above a block of its figures, one row each, so
+    that no name or number is folded.
 
     Parameters
     ----------
     rows : dict of str to dict
         Each run's name and its ``summary.json`` contents (:func:`tmem.analysis.metrics.summarize`).
     """
-    headers = ("run", "function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "min dist (m)")
-    table = Table(*(Column(h, overflow="fold") for h in headers))  # whole names, folded, not cut with "…"
-    for name, s in rows.items():
-        swings = s["rms_change_while_coupled"] and s["rms_change_percent"] is not None
-        table.add_row(
-            Text(name), s["function"], _coupled_cell(s), _number(s["couple_time"], "{:.2f}"),
-            _number(s["uncouple_time"], "{:.2f}"), _number(s["rms_change_percent"], "{:+.3f}") + (" *" if swings else ""),
-            _number(s["min_distance"], "{:.2f}"),
-        )  # fmt: skip
-        if swings:
-            table.caption, table.caption_justify = SWINGS, "left"
-    return table
+
+    def __init__(self, rows: dict[str, dict]) -> None:
+        self.rows = rows
+
+    def fits(self, width: int) -> bool:
+        """Whether one row per run fits ``width`` characters.
+
+        Parameters
+        ----------
+        width : int
+            The width available (characters).
+        """
+        return Console(width=10**4).measure(_wide(self.rows)).maximum <= width
+
+    def __rich_console__(self, console: Console, options):
+        if self.fits(options.max_width):
+            yield _wide(self.rows)
+        else:
+            for name, s in self.rows.items():
+                yield Text(name, style="bold")
+                yield Padding(_block(s), (0, 0, 1, 2))
+        if any(swings(s) for s in self.rows.values()):
+            yield Text(SWINGS)
+
+
+def summary_table(rows: dict[str, dict]) -> RunsTable:
+    """The runs' headline figures (:class:`RunsTable`), to print on a console of any width.
+
+    ΔRMS is marked ``*`` where pairs coupled at the end still oscillate (``rms_change_swings``);
+    "largest ΔRMS" is the change from the start with the largest magnitude over the recorded times,
+    and when it came (``rms_change_peak_percent``, ``rms_change_peak_time``): the start-up transient
+    that ΔRMS, from the start to the end, does not show.
+
+    Parameters
+    ----------
+    rows : dict of str to dict
+        Each run's name and its ``summary.json`` contents (:func:`tmem.analysis.metrics.summarize`).
+    """
+    return RunsTable(rows)

@@ -12,7 +12,7 @@ Which ones are drawn
 --------------------
 A figure draws every agent and every pair one by one up to :data:`MAX_LINES` of them; past that it
 draws that many and says in its title which ones and why (``"100 of 400 agents: the first 100
-recorded"``).  Up to :data:`MAX_LEGEND` lines get a legend entry each; more are coloured by agent
+recorded"``; in ``paths.png``, agents spread over where the swarm started, :func:`spread_agents`).  Up to :data:`MAX_LEGEND` lines get a legend entry each; more are coloured by agent
 number, with a colour bar.
 
 Strain
@@ -102,6 +102,16 @@ class Chosen:
     note: str
 
 
+def _chosen(total: int, at_most: int | None, pick) -> Chosen:
+    """Every one of ``total`` if they are no more than ``at_most`` (default :data:`MAX_LINES`), else
+    ``pick(at_most)``'s positions and note."""
+    at_most = MAX_LINES if at_most is None else at_most
+    if total <= at_most:
+        return Chosen(np.arange(total), total, "")
+    index, note = pick(at_most)
+    return Chosen(index, total, note)
+
+
 def first_agents(total: int, at_most: int | None = None) -> Chosen:
     """The first ``at_most`` of ``total`` recorded agents.
 
@@ -112,10 +122,51 @@ def first_agents(total: int, at_most: int | None = None) -> Chosen:
     at_most : int, optional
         Most drawn; default :data:`MAX_LINES`.
     """
-    at_most = MAX_LINES if at_most is None else at_most
-    if total <= at_most:
-        return Chosen(np.arange(total), total, "")
-    return Chosen(np.arange(at_most), total, f"{at_most} of {total} agents: the first {at_most} recorded")
+    return _chosen(total, at_most, lambda m: (np.arange(m), f"{m} of {total} agents: the first {m} recorded"))
+
+
+def spread_agents(starts: np.ndarray, box: np.ndarray | None = None, at_most: int | None = None) -> Chosen:
+    """At most ``at_most`` agents spread over where the swarm started: each the farthest from those
+    already chosen (farthest-point sampling), from the one nearest the middle of the starts.
+
+    Agents numbered by where they were placed (rows or cells of a lattice, a random draw sorted
+    into strips) would otherwise all be drawn from one part of the space.
+
+    Parameters
+    ----------
+    starts : ndarray, shape (agents, axes)
+        Each agent's first flying position (m); NaN for an agent that never flew (chosen last).
+    box : ndarray, shape (axes,), optional
+        The periodic box's sides (m), to measure across its edges; None or 0 on an open axis.
+    at_most : int, optional
+        Most chosen; default :data:`MAX_LINES`.
+    """
+    return _chosen(len(starts), at_most, lambda m: _farthest_points(starts, box, m))
+
+
+def _farthest_points(starts: np.ndarray, box: np.ndarray | None, count: int) -> tuple[np.ndarray, str]:
+    """``count`` agents by farthest-point sampling of ``starts`` (:func:`spread_agents`), and the note."""
+    total = len(starts)
+    flew = np.isfinite(starts).all(axis=1)
+    points = np.where(flew[:, None], starts, 0.0)
+    sides = np.zeros(starts.shape[1]) if box is None else np.asarray(box, dtype=float)
+
+    def distances(point: np.ndarray) -> np.ndarray:
+        delta = points - point
+        delta = np.where(sides > 0, delta - sides * np.round(delta / np.where(sides > 0, sides, 1.0)), delta)
+        return np.where(flew, np.linalg.norm(delta, axis=1), -1.0)
+
+    middle = points[flew].mean(axis=0) if flew.any() else np.zeros(starts.shape[1])
+    chosen = [int(np.argmin(np.where(flew, np.linalg.norm(points - middle, axis=1), np.inf)))]
+    nearest = distances(points[chosen[0]])
+    for _ in range(count - 1):
+        k = int(np.argmax(nearest))
+        if nearest[k] < 0:  # every agent that flew is chosen: the rest in their order
+            k = int(np.flatnonzero(~np.isin(np.arange(total), chosen))[0])
+        chosen.append(k)
+        nearest = np.minimum(nearest, distances(points[k]))
+        nearest[chosen] = -1.0
+    return np.sort(np.array(chosen)), f"{count} of {total} agents: spread over where they started"
 
 
 def closest_pairs(min_distance: np.ndarray, at_most: int | None = None) -> Chosen:
@@ -128,12 +179,9 @@ def closest_pairs(min_distance: np.ndarray, at_most: int | None = None) -> Chose
     at_most : int, optional
         Most drawn; default :data:`MAX_LINES`.
     """
-    at_most = MAX_LINES if at_most is None else at_most
     total = len(min_distance)
-    if total <= at_most:
-        return Chosen(np.arange(total), total, "")
-    index = np.sort(np.argsort(min_distance, kind="stable")[:at_most])
-    return Chosen(index, total, f"{at_most} of {total} pairs: the {at_most} that came closest")
+    closest = lambda m: (np.sort(np.argsort(min_distance, kind="stable")[:m]), f"{m} of {total} pairs: the {m} that came closest")  # noqa: E731
+    return _chosen(total, at_most, closest)
 
 
 def evenly(total: int, at_most: int, noun: str) -> Chosen:

@@ -5,8 +5,10 @@
     On one axis, each agent's position against time, as the paper draws it.  In the plane, each
     agent's path in (x, y), from a ring at its start to a dot at its end, numbered at its end.  In
     3-D, a 3-D view and the (x, y) projection side by side.  A removed agent's path stops where it
-    was removed.  Every recorded agent up to :data:`tmem.figures.drawing.MAX_LINES`; past that, the title
-    says which are drawn.
+    was removed.  In a periodic box a path that leaves by one side and comes back by the other is
+    broken there, not drawn across the box.  Every recorded agent up to
+    :data:`tmem.figures.drawing.MAX_LINES`; past that, that many spread over where the swarm started
+    (:func:`tmem.figures.drawing.spread_agents`), and the title says so.
 ``shape.png`` (2-D and 3-D runs)
     Every recorded agent and every pair between them at the moments of :func:`moments`, side by
     side in views of one size and scale, each centred on the agents at its moment: coupled pairs (``F_en = 1``) as solid lines coloured by their strain
@@ -21,6 +23,8 @@ Positions are drawn as recorded; in a periodic box, a pair across the box's edge
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
@@ -28,10 +32,12 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from tmem.figures.drawing import (
-    MAX_LEGEND, MAX_NUMBERED, STRAIN_LABEL, agent_colors, agent_label, agents_legend, columns_of, draw_region, first_agents,
-    run_title, strain, strain_colormap, strain_limit, strain_norm,
+    MAX_LEGEND, MAX_NUMBERED, STRAIN_LABEL, agent_colors, agent_label, agents_legend, columns_of, draw_region, run_title,
+    spread_agents, strain, strain_colormap, strain_limit, strain_norm,
 )  # fmt: skip
-from tmem.engine import Trajectory
+
+if TYPE_CHECKING:  # the animation draws its 3-D view with space_view, without the engine
+    from tmem.engine import Trajectory
 
 #: Most moments drawn in ``shape.png``.
 MAX_MOMENTS = 4
@@ -70,11 +76,27 @@ def _plane(ax, trajectory: Trajectory, low: np.ndarray, high: np.ndarray) -> Non
     draw_region(ax, scenario.space.box, scenario.space.walls, [(o.center, o.radius) for o in scenario.obstacles])
 
 
-def _space(ax, low: np.ndarray, high: np.ndarray) -> None:
-    """A 3-D view: limits, equal scale, labels."""
-    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]), xlabel="x, m", ylabel="y, m")
-    ax.set_zlabel("z, m")
+#: How much of its panel a 3-D view's box fills: less than matplotlib's 1, so that the axes' labels
+#: fall inside the panel, not under the next one (the layout does not make room for them).
+SPACE_ZOOM = 0.7
+
+
+def space_view(ax, low: np.ndarray, high: np.ndarray) -> None:
+    """Set up a 3-D view: limits, equal scale, labels clear of the tick values, all inside its panel.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes3D
+        The view.
+    low, high : ndarray, shape (3,)
+        The corners of the space shown (m).
+    """
+    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+    for axis, name in zip((ax.xaxis, ax.yaxis, ax.zaxis), "xyz"):
+        axis.set_label_text(f"{name}, m")
+        axis.labelpad = 10
     ax.set_aspect("equal")
+    ax.set_box_aspect(None, zoom=SPACE_ZOOM)
 
 
 def _number(ax, trajectory: Trajectory, points: np.ndarray, columns: np.ndarray) -> None:
@@ -86,12 +108,40 @@ def _number(ax, trajectory: Trajectory, points: np.ndarray, columns: np.ndarray)
             ax.annotate(str(trajectory.agents[q] + 1), points[q, :2], xytext=(4, 4), textcoords="offset points", fontsize=8)
 
 
-def _last_flying(flying: np.ndarray) -> np.ndarray:
-    """Each agent's last flying position (agent, axis): where its path ends; NaN if it never flew."""
+def _flying_end(flying: np.ndarray, first: bool) -> np.ndarray:
+    """Each agent's first (or last) flying position (agent, axis): where its path starts (ends); NaN
+    if it never flew."""
     seen = np.isfinite(flying).all(axis=-1)
-    last = len(flying) - 1 - np.argmax(seen[::-1], axis=0)
-    ends = flying[last, np.arange(flying.shape[1])]
-    return np.where(seen.any(axis=0)[:, None], ends, np.nan)
+    k = np.argmax(seen, axis=0) if first else len(flying) - 1 - np.argmax(seen[::-1], axis=0)
+    return np.where(seen.any(axis=0)[:, None], flying[k, np.arange(flying.shape[1])], np.nan)
+
+
+def broken_at_wraps(values: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """Positions over time (time, ...) with a NaN between two records where a periodic coordinate
+    jumps by more than half the box (the agent left by one side and came back by the other), so
+    that a line drawn through them stops at one side and starts again at the other.
+
+    Parameters
+    ----------
+    values : ndarray, shape (time, ..., axes)
+        Positions (m); NaN where an agent is not flying.
+    box : ndarray, shape (axes,)
+        The periodic box's sides (m); 0 on an open axis.
+
+    Returns
+    -------
+    ndarray, shape (2 time - 1, ..., axes)
+        The records, each but the first after a copy of itself, or after NaN where it wrapped;
+        ``values`` itself where no axis is periodic.
+    """
+    box = np.asarray(box, dtype=float)
+    if not np.any(box > 0):
+        return values
+    jump = (np.abs(np.diff(values, axis=0)) > np.where(box > 0, box / 2, np.inf)).any(axis=-1)
+    out = np.empty((2 * len(values) - 1, *values.shape[1:]))
+    out[0::2] = values
+    out[1::2] = np.where(jump[..., None], np.nan, values[1:])
+    return out
 
 
 def paths_figure(trajectory: Trajectory):
@@ -103,14 +153,18 @@ def paths_figure(trajectory: Trajectory):
         A run (:func:`tmem.simulate`, or :func:`tmem.files.saved.read_run`).
     """
     n_axes = trajectory.scenario.space.axes
-    chosen = first_agents(trajectory.state.shape[1])
+    box = np.asarray(trajectory.initial.box, dtype=float)
+    everyone = _flying_positions(trajectory)
+    chosen = spread_agents(_flying_end(everyone, first=True), box)
     colors, mappable = agent_colors(trajectory.agents[chosen.index])
-    flying = _flying_positions(trajectory)[:, chosen.index]
+    flying = everyone[:, chosen.index]
+    drawn = broken_at_wraps(flying, box)
     fig = Figure(figsize=(13, 6) if n_axes == 3 else (8, 6) if n_axes == 2 else (8, 4.5), layout="constrained")
     if n_axes == 1:
         ax = fig.subplots()
+        time = np.repeat(trajectory.time, 2)[1:] if len(drawn) > len(flying) else trajectory.time  # see broken_at_wraps
         for q, color in enumerate(colors):
-            ax.plot(trajectory.time, flying[:, q, 0], color=color, linewidth=1.2, label=agent_label(trajectory.agents[chosen.index[q]]))
+            ax.plot(time, drawn[:, q, 0], color=color, linewidth=1.2, label=agent_label(trajectory.agents[chosen.index[q]]))
         ax.set(xlabel="time, s", ylabel="position x, m")
         ax.grid(alpha=0.3)
     else:
@@ -120,13 +174,13 @@ def paths_figure(trajectory: Trajectory):
         views = [ax]
         if n_axes == 3:
             views.append(fig.add_subplot(1, 2, 1, projection="3d"))
-            _space(views[1], low, high)
+            space_view(views[1], low, high)
             ax.set_title("projection on (x, y)")
-        starts = flying[np.argmax(np.isfinite(flying).all(axis=-1), axis=0), np.arange(flying.shape[1])]
-        ends = _last_flying(flying)
+        starts = _flying_end(flying, first=True)
+        ends = _flying_end(flying, first=False)
         for view in views:
             for q, color in enumerate(colors):
-                view.plot(*flying[:, q].T[: 3 if view.name == "3d" else 2], color=color, linewidth=1.0,
+                view.plot(*drawn[:, q].T[: 3 if view.name == "3d" else 2], color=color, linewidth=1.0,
                           label=agent_label(trajectory.agents[chosen.index[q]]))  # fmt: skip
             dims = slice(0, 3 if view.name == "3d" else 2)
             view.scatter(*starts[:, dims].T, s=20, facecolors="none", edgecolors=colors)
@@ -229,7 +283,7 @@ def shape_figure(trajectory: Trajectory):
     for k, ((name, record), (low, high)) in enumerate(zip(shown, windows)):
         ax = fig.add_subplot(1, len(shown), k + 1, projection="3d" if n_axes == 3 else None, label=name)
         if n_axes == 3:
-            _space(ax, low, high)
+            space_view(ax, low, high)
         else:
             _plane(ax, trajectory, low, high)
         _draw_moment(ax, trajectory, (name, record), pairs, norm, colors)

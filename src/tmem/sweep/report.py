@@ -13,7 +13,8 @@ failed are counted and left out of the statistics.
   the median delay from the command to the uncoupling;
 * the other kept metrics: median, 5th and 95th percentiles;
 * figures: ``rms_change_histogram.png`` (a histogram per setting) and
-  ``rms_change_vs_<parameter>.png`` for each numeric parameter that varies.
+  ``rms_change_vs_<parameter>.png`` for each numeric parameter that varies, each setting in a
+  colour and marker of its own, the legend beside the plot.
 """
 
 from __future__ import annotations
@@ -200,20 +201,61 @@ def _figures(groups: list[tuple[str, pd.DataFrame]], table: pd.DataFrame, sweep:
         values = pd.to_numeric(table[path], errors="coerce")
         if values.isna().all() or values.nunique() < 2 or table[path].map(lambda v: isinstance(v, bool)).any():
             continue  # nothing to draw against, or settings rather than a scale
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for label, group in groups:
-            ok = group["error"].isna()
-            ax.scatter(pd.to_numeric(group.loc[ok, path], errors="coerce"), group.loc[ok, RMS], s=3, alpha=0.4, label=label)
-        ax.set_xlabel(path)
-        ax.set_ylabel("RMS velocity change (%)")
-        if len(groups) > 1:
-            ax.legend(fontsize=8, markerscale=4)
-        fig.tight_layout()
+        fig = scatter_figure(groups, path)
         name = f"rms_change_vs_{path.replace('.', '_')}.png"
         write_atomically(out / name, lambda tmp: fig.savefig(tmp, dpi=110))
         plt.close(fig)
         names.append(name)
     return ["## Figures", "", *[f"![{n}]({n})" for n in names], ""]
+
+
+#: Markers taken in turn past ten settings, so that settings of near colours differ in shape.
+MARKERS = ("o", "s", "^", "D", "v")
+
+
+def setting_styles(count: int) -> list[tuple[tuple, str]]:
+    """A colour and a marker for each of ``count`` settings, no two alike: Matplotlib's ten colours
+    up to ten settings, its twenty up to twenty, else colours spread over a colour map, with the
+    markers of :data:`MARKERS` in turn past ten.
+
+    Parameters
+    ----------
+    count : int
+        How many settings.
+    """
+    from matplotlib import colormaps
+
+    if count <= 10:
+        colours = colormaps["tab10"].colors[:count]
+    elif count <= 20:
+        colours = colormaps["tab20"].colors[:count]
+    else:
+        colours = [tuple(c) for c in colormaps["turbo"](np.linspace(0.0, 1.0, count))]
+    return [(tuple(colour), "o" if count <= 10 else MARKERS[k % len(MARKERS)]) for k, colour in enumerate(colours)]
+
+
+def scatter_figure(groups: list[tuple[str, pd.DataFrame]], path: str):
+    """The RMS change of every case against parameter ``path``, one colour and marker per setting
+    (:func:`setting_styles`), the legend beside the axes, where it hides no point.
+
+    Parameters
+    ----------
+    groups : list of (str, pandas.DataFrame)
+        The settings and their rows (:func:`settings`).
+    path : str
+        The parameter on the horizontal axis: a column of the rows.
+    """
+    fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
+    for (label, group), (colour, marker) in zip(groups, setting_styles(len(groups))):
+        ok = group["error"].isna()
+        ax.scatter(pd.to_numeric(group.loc[ok, path], errors="coerce"), group.loc[ok, RMS], s=3, alpha=0.4,
+                   color=colour, marker=marker, label=label)  # fmt: skip
+    ax.set_xlabel(path)
+    ax.set_ylabel("RMS velocity change (%)")
+    if len(groups) > 1:
+        columns = -(-len(groups) // 20)
+        ax.legend(fontsize=8, markerscale=4, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, ncols=columns)
+    return fig
 
 
 def write_report(table: pd.DataFrame, sweep: Sweep, out: str | Path) -> Path:

@@ -1,4 +1,4 @@
-"""Animation of a 2-D or 3-D run from its ``trajectory.nc``.
+"""Animation of a run from its ``trajectory.nc``: on one axis, in the plane or in space.
 
 Each frame shows, at one recorded time (:mod:`tmem.figures.animate.scene`):
 
@@ -16,7 +16,8 @@ Each frame shows, at one recorded time (:mod:`tmem.figures.animate.scene`):
   agents not yet added are hidden;
 * a clock, ``t = 12.3 s``.
 
-A 2-D run is drawn in the (x, y) plane; a 3-D run as a 3-D view beside its (x, y) projection.
+A run on one axis (the paper's) is drawn on the line ``y = 0``; a 2-D run in the (x, y) plane; a
+3-D run as a 3-D view beside its (x, y) projection.
 Runs of more than :data:`~tmem.figures.animate.frames.MAX_AGENTS_DRAWN` agents are thinned to that many,
 chosen evenly, and the title says so; pairs are drawn between drawn agents only.  The static part
 of the figure is drawn once; each frame updates the moving artists and blits them over it, so a
@@ -57,7 +58,7 @@ def animate(
     max_frames: int = 400,
     dpi: int = 100,
 ) -> Path:
-    """Write an animation of a 2-D or 3-D run.
+    """Write an animation of a run on 1, 2 or 3 axes.
 
     Parameters
     ----------
@@ -71,7 +72,7 @@ def animate(
     max_frames : int
         Most frames; the recorded times are subsampled evenly to this many.
     dpi : int
-        Resolution; the figure is 7 x 6 inches (12 x 6 for a 3-D run).
+        Resolution; the figure is 7 x 6 inches (9 x 3.6 for a run on one axis, 12 x 6 in 3-D).
 
     Returns
     -------
@@ -82,7 +83,7 @@ def animate(
     ------
     ValueError
         With a one-line message: a missing folder, no ``trajectory.nc``, one
-        that cannot be read (damaged or truncated), a run on one axis,
+        that cannot be read (damaged or truncated), nothing recorded,
         no ``interaction.radius`` in the scenario, an output that is neither
         ``.gif`` nor ``.mp4``, or MP4 without ffmpeg; an ``out`` that
         exists and was not written by ``animate`` (:func:`tmem.files.outputs.check_file`).

@@ -24,7 +24,7 @@ class Frames:
     time : ndarray, shape (frame,)
         The frames' times (s).
     pos : ndarray, shape (frame, agent, axes)
-        Positions of the drawn agents (m); 2 or 3 axes.
+        Positions of the drawn agents (m); 2 or 3 axes (a run on one axis with ``y = 0``).
     active : ndarray, shape (frame, agent), bool
         Whether each drawn agent flies.
     agents : ndarray, shape (agent,)
@@ -45,6 +45,8 @@ class Frames:
         The walled box's sides (m); None without walls.
     obstacles : list
         ``(center, radius)`` of each obstacle (m).
+    line : bool
+        Whether the run flew on one axis (drawn on the line ``y = 0``).
     """
 
     time: np.ndarray
@@ -60,6 +62,7 @@ class Frames:
     name: str
     box: list | None
     obstacles: list
+    line: bool = False
 
     @property
     def n_axes(self) -> int:
@@ -80,8 +83,8 @@ def read_frames(run_dir: str | Path, max_frames: int) -> Frames:
     Raises
     ------
     tmem.files.trajectory_file.RunReadError
-        In one line: no such folder or file, a damaged or truncated file, a run on one axis, one
-        with nothing recorded, a scenario without ``interaction.radius``.
+        In one line: no such folder or file, a damaged or truncated file, one with nothing
+        recorded, a scenario without ``interaction.radius``.
     """
     path = trajectory_path(run_dir, "animate")
     with reading(path, "animate"):
@@ -97,19 +100,18 @@ def _scenario(ds, path: Path) -> tuple[dict, float]:
 
 
 def _read(path: Path, max_frames: int) -> Frames:
-    """Read the frames and agents to draw from ``path``; refuse runs on one axis."""
+    """Read the frames and agents to draw from ``path``; a run on one axis on the line ``y = 0``."""
     with open_trajectory(path) as ds:
         check_layout(ds, path, "animate")
-        n_axes = len(run_axes(ds))
-        if n_axes not in (2, 3):
-            noun = "axis" if n_axes == 1 else "axes"
-            raise RunReadError(f"animate: the run has {n_axes} {noun}; only 2-D and 3-D runs can be animated")
         if ds.sizes["time"] == 0 or ds.sizes["agent"] == 0:
             raise RunReadError("animate: the run has no recorded times or agents")
         scenario, radius = _scenario(ds, path)
         drawn = evenly(ds.sizes["agent"], MAX_AGENTS_DRAWN, "agents")
         sub = ds.isel(time=evenly(ds.sizes["time"], max_frames, "frames").index, agent=drawn.index)
         pos = positions(sub)
+        line = pos.shape[2] == 1
+        if line:
+            pos = np.concatenate([pos, np.zeros_like(pos)], axis=-1)
         active = over_time(sub, "active").astype(bool) if "active" in sub else np.ones(pos.shape[:2], bool)
         # Pairs whose two agents are both drawn (``pair_i``/``pair_j`` hold agent indices).
         col_i, ok_i = columns_of(sub["agent"].values, ds["pair_i"].values)
@@ -126,5 +128,5 @@ def _read(path: Path, max_frames: int) -> Frames:
             flag=over_time(sub.isel(pair=kept), "F_en"),
             d_t=d_t, radius=radius, name=str(scenario.get("name", "")),
             box=scenario["space"]["box"] if scenario.get("space", {}).get("walls") else None,
-            obstacles=[(o["center"], o["radius"]) for o in scenario.get("obstacles", [])],
+            obstacles=[(o["center"], o["radius"]) for o in scenario.get("obstacles", [])], line=line,
         )  # fmt: skip

@@ -1,6 +1,7 @@
 """The animation's figure: drawn once, with the artists that move from frame to frame.
 
-A 2-D run is one (x, y) view.  A 3-D run is a 3-D view beside its (x, y) projection; the
+A run on one axis is drawn on the line ``y = 0`` of a view along x, as the paper's Figs. 5, 7 and 9
+fly it: each agent with its interaction circle, the pair between them.  A 2-D run is one (x, y) view.  A 3-D run is a 3-D view beside its (x, y) projection; the
 interaction circles, the agents' numbers and the walls are drawn in the projection.  The views are
 fixed for the whole animation (equal scale, limits covering every drawn position with a margin of
 ``R``, at least 2 % of the extent).
@@ -17,6 +18,7 @@ from matplotlib.lines import Line2D
 
 from tmem.figures.drawing import MAX_NUMBERED, STRAIN_LABEL, draw_region, strain, strain_colormap, strain_limit, strain_norm
 from tmem.figures.animate.frames import Frames
+from tmem.figures.shape_plot import space_view
 
 #: Most agents drawn with their interaction circles.
 MAX_CIRCLES = 2000
@@ -85,18 +87,18 @@ def _limits(run: Frames, shown: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _views(run: Frames, shown: np.ndarray, dpi: int) -> tuple[Figure, object, object | None]:
     """The figure, its (x, y) view and, for a 3-D run, its 3-D view."""
     three = run.n_axes == 3
-    fig = Figure(figsize=(12, 6) if three else (7, 6), dpi=dpi, layout="constrained")
+    fig = Figure(figsize=(12, 6) if three else (9, 3.6) if run.line else (7, 6), dpi=dpi, layout="constrained")
     FigureCanvasAgg(fig)
     space = fig.add_subplot(1, 2, 1, projection="3d") if three else None
     plane = fig.add_subplot(1, 2, 2) if three else fig.add_subplot()
     low, high = _limits(run, shown)
     plane.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), aspect="equal", xlabel="x, m", ylabel="y, m")
     plane.grid(alpha=0.3)
+    if run.line:  # one axis: y means nothing
+        plane.set(ylabel="", yticks=[])
     draw_region(plane, run.box, run.box is not None, run.obstacles)
     if space is not None:
-        space.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]), xlabel="x, m", ylabel="y, m")
-        space.set_zlabel("z, m")
-        space.set_aspect("equal")
+        space_view(space, low, high)
         plane.set_title("projection on (x, y)")
     drawn = f"{len(run.agents)} agents" if not run.agents_note else run.agents_note
     fig.suptitle(f"{run.name + ': ' if run.name else ''}{drawn}, R = {run.radius:g} m", parse_math=False)

@@ -20,6 +20,7 @@ from importlib import resources
 import numpy as np
 
 from tmem import __version__
+from tmem.analysis.rms import SWINGS, swings
 from tmem.figures.viewer.data import View
 
 #: The mark of a file written by ``tmem view`` (in the page's first line of comment).
@@ -30,6 +31,7 @@ MODULES = {
     "three/addons/OrbitControls": ("vendor", "OrbitControls.js"),
     "tmem/run": ("web", "run.js"),
     "tmem/edges": ("web", "edges.js"),
+    "tmem/axes": ("web", "axes.js"),
     "tmem/scene": ("web", "scene.js"),
     "tmem/charts": ("web", "charts.js"),
     "tmem/main": ("web", "main.js"),
@@ -81,22 +83,40 @@ def _number(value, form: str, unit: str = "") -> str:
 def headline(summary: dict) -> list[tuple[str, str]]:
     """The figures of ``summary.json`` shown above the view, as (label, text); "—" for one missing.
 
+    ΔRMS, from the start to the end, is marked ``*`` where it swings (:func:`tmem.analysis.rms.swings`,
+    explained by :func:`caveat`); "largest ΔRMS" is the change from the start with the largest
+    magnitude on the way, and when (``rms_change_peak_percent``, ``rms_change_peak_time``).
+
     Parameters
     ----------
     summary : dict
         ``summary.json`` as read (:func:`tmem.analysis.metrics.summarize`).
     """
     pairs = summary.get("pairs")
+    peak, at = summary.get("rms_change_peak_percent"), summary.get("rms_change_peak_time")
     rows = [
         ("agents", _number(summary.get("agents"), "{:d}")),
         ("function", str(summary.get("function", "—"))),
         ("duration", _number(summary.get("duration"), "{:g}", " s")),
-        ("ΔRMS", _number(summary.get("rms_change_percent"), "{:+.3f}", " %")),
+        ("ΔRMS", _number(summary.get("rms_change_percent"), "{:+.3f}", " %") + (" *" if swings(summary) else "")),
+        ("largest ΔRMS", _number(peak, "{:+.3f}", " %") + (_number(at, " at {:.2f}", " s") if isinstance(peak, float) else "")),
         ("min distance", _number(summary.get("min_distance"), "{:.2f}", " m")),
     ]
     if isinstance(pairs, list) and pairs:
         rows.append(("pairs coupled at end", f"{_number(summary.get('pairs_coupled_at_end'), '{:d}')}/{len(pairs)}"))
     return rows
+
+
+def caveat(summary: dict) -> str:
+    """What the page says under its headline of a ΔRMS that swings (:data:`tmem.analysis.rms.SWINGS`,
+    as the printed table says it); empty when it does not.
+
+    Parameters
+    ----------
+    summary : dict
+        ``summary.json`` as read (:func:`tmem.analysis.metrics.summarize`).
+    """
+    return f"* {SWINGS}" if swings(summary) else ""
 
 
 def page_data(view: View) -> dict:
@@ -128,6 +148,7 @@ def page_data(view: View) -> dict:
         "pairDistance": _b64(view.pair_distance, "<f4"),
         "dT": view.d_t,
         "headline": headline(view.summary),
+        "caveat": caveat(view.summary),
         "note": view.note,
     }
 

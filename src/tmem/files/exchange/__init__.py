@@ -1,7 +1,7 @@
 """A run passed on to the tools of the field: ``tmem export DIR --to mcap`` or ``--to csv``.
 
 * :mod:`~tmem.files.exchange.recording` — the run directory read back (``trajectory.nc``);
-* :mod:`~tmem.files.exchange.attitude` — an agent's attitude quaternion from its tilts;
+* :mod:`~tmem.files.exchange.attitude` — an agent's attitude quaternion: the recorded body attitude, else its tilts';
 * :mod:`~tmem.files.exchange.foxglove` — an MCAP file of Foxglove's messages (the 3-D scene, plots);
 * :mod:`~tmem.files.exchange.crazyswarm` — Crazyswarm2-style CSV files, one per agent.
 

@@ -1,39 +1,67 @@
-"""An agent's attitude from its tilts: the quaternion that exchange formats carry.
+"""An agent's attitude as the exchange formats carry it: a unit quaternion ``(qw, qx, qy, qz)``.
 
-The paper's model (2) moves an agent along a horizontal axis by tilting it: ``dV/dt = g phi``.
-A multirotor accelerates along +x by pitching its thrust towards +x, a rotation about its body y
-axis by ``phi_x``; along +y by rolling it towards +y, a rotation about its body x axis by
-``-phi_y``.  With z up and no yaw, the attitude is the rotation
+A run that records a body attitude (a quadrotor's quaternion, ``q_x`` ... ``q_w`` in
+``trajectory.nc``) exports that attitude as it was recorded (:func:`body_attitude`).  A run of the
+paper's model (2) has only its tilts, and exports the attitude they define (:func:`attitude_quaternion`).
 
-    R = Rz(0) Ry(phi_x) Rx(-phi_y),
+The tilt on a horizontal axis ``a`` is defined, as for the quadrotor (``docs/vehicles.md``), from the
+thrust axis ``b_3`` (the body's z axis in the world): ``phi_a = atan2(b_3a, b_3z)``.  Model (2)
+accelerates along ``a`` as ``g phi_a``: a tilt towards +x pitches the thrust towards +x, one towards
++y rolls it towards +y.  With z up and no yaw, the attitude with the tilts ``phi_x``, ``phi_y`` is
 
-Z-Y-X Euler angles (yaw 0, pitch ``phi_x``, roll ``-phi_y``), which turns the thrust axis ``e_z``
-to ``(sin phi_x cos phi_y, sin phi_y, cos phi_x cos phi_y)``.  A run's tilt on a vertical axis (its
-third, in 3-D) changes the thrust, not the attitude, and does not enter it.
+    R = Rz(0) Ry(theta) Rx(rho),   theta = phi_x,   tan(rho) = -tan(phi_y) cos(phi_x),
+
+Z-Y-X Euler angles (yaw 0, pitch ``theta``, roll ``rho``), which turns ``e_z`` to a thrust axis along
+``(tan phi_x, tan phi_y, 1)``.  A run's tilt on a vertical axis (its third, in 3-D) changes the
+thrust, not the attitude, and does not enter it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["attitude_quaternion"]
+__all__ = ["attitude_quaternion", "body_attitude"]
 
 
 def attitude_quaternion(phi_x: np.ndarray, phi_y: np.ndarray) -> np.ndarray:
-    """The attitude ``Ry(phi_x) Rx(-phi_y)`` (yaw 0, z up) as unit quaternions ``(qw, qx, qy, qz)``, ``qw > 0``.
+    """The attitude with the tilts ``phi_x``, ``phi_y`` and no yaw, ``Ry(theta) Rx(rho)``, as unit
+    quaternions ``(qw, qx, qy, qz)``, ``qw > 0``.
 
     Parameters
     ----------
     phi_x : ndarray
-        Tilt on the x axis (rad): positive pitches the thrust towards +x.
+        Tilt on the x axis, ``atan2(b_3x, b_3z)`` (rad), within (-pi/2, pi/2): positive pitches the
+        thrust towards +x.
     phi_y : ndarray, same shape
-        Tilt on the y axis (rad): positive rolls the thrust towards +y.
+        Tilt on the y axis, ``atan2(b_3y, b_3z)`` (rad), within (-pi/2, pi/2): positive rolls the
+        thrust towards +y.
 
     Returns
     -------
     ndarray, shape (..., 4)
-        The product of ``(cos(phi_x/2), 0, sin(phi_x/2), 0)`` and ``(cos(phi_y/2), -sin(phi_y/2), 0, 0)``.
+        The product of ``(cos(theta/2), 0, sin(theta/2), 0)`` and ``(cos(rho/2), sin(rho/2), 0, 0)``,
+        ``theta = phi_x`` and ``rho = -atan(tan(phi_y) cos(phi_x))``.
     """
-    cb, sb = np.cos(0.5 * np.asarray(phi_x)), np.sin(0.5 * np.asarray(phi_x))
-    ca, sa = np.cos(-0.5 * np.asarray(phi_y)), np.sin(-0.5 * np.asarray(phi_y))
+    theta = np.asarray(phi_x, dtype=float)
+    rho = -np.arctan(np.tan(np.asarray(phi_y, dtype=float)) * np.cos(theta))
+    cb, sb = np.cos(0.5 * theta), np.sin(0.5 * theta)
+    ca, sa = np.cos(0.5 * rho), np.sin(0.5 * rho)
     return np.stack([ca * cb, sa * cb, ca * sb, -sa * sb], axis=-1)
+
+
+def body_attitude(q_x: np.ndarray, q_y: np.ndarray, q_z: np.ndarray, q_w: np.ndarray) -> np.ndarray:
+    """A recorded body attitude (scalar last, body to world) as unit quaternions ``(qw, qx, qy, qz)``,
+    ``qw >= 0`` (``q`` and ``-q`` are one attitude).
+
+    Parameters
+    ----------
+    q_x, q_y, q_z, q_w : ndarray, one shape
+        The recorded quaternion's parts (``trajectory.nc``'s ``q_x`` ... ``q_w``).
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+    """
+    q = np.stack([q_w, q_x, q_y, q_z], axis=-1).astype(float)
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    return np.where(q[..., :1] < 0, -q, q)

@@ -3,8 +3,9 @@
 Each recorded agent gets ``agentN.csv``, ``N`` its number as the paper counts agents (the
 scenario's index plus 1), with one row per recorded time: the seconds from the start of the run,
 the position (m, the run's local frame, z up; 0 on the axes the run does not have) and the
-attitude quaternion from the tilts (:mod:`tmem.files.exchange.attitude`: yaw 0).  Numbers are written
-in full (the shortest text that reads back to the same double).
+attitude quaternion (the body attitude the run recorded, else the tilts', yaw 0:
+:mod:`tmem.files.exchange.attitude`).  Numbers are written in full (the shortest text that reads
+back to the same double).
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ from pathlib import Path
 import numpy as np
 
 from tmem.files.outputs import replace_directory
-from tmem.files.exchange.attitude import attitude_quaternion
 from tmem.files.exchange.recording import Recording
 
 __all__ = ["HEADER", "csv_name", "write_csv_files", "export_csv"]
@@ -45,7 +45,7 @@ def write_csv_files(recording: Recording, directory: Path) -> list[Path]:
     directory : Path
         An existing directory.
     """
-    quaternions = attitude_quaternion(recording.tilts[..., 0], recording.tilts[..., 1])
+    quaternions = recording.attitude
     written = []
     for k in range(len(recording.agents)):
         rows = np.column_stack([recording.time, recording.positions[:, k], quaternions[:, k]]) + 0.0  # no -0.0

@@ -30,7 +30,6 @@ import numpy as np
 from tmem import __version__
 from tmem.files.outputs import replace_file
 from tmem.files.trajectory_file import FRAME
-from tmem.files.exchange.attitude import attitude_quaternion
 from tmem.files.exchange.recording import Recording
 
 __all__ = ["EXPORT_MARK", "FRAME_ID", "TOPIC_RMS", "TOPIC_SCENE", "export_mcap", "pair_topic", "write_mcap"]
@@ -146,7 +145,7 @@ def write_mcap(recording: Recording, path: Path) -> None:
     """
     from mcap.writer import CompressionType, Writer
 
-    quaternions = attitude_quaternion(recording.tilts[..., 0], recording.tilts[..., 1])
+    quaternions = recording.attitude
     slot = {int(a): k for k, a in enumerate(recording.agents)}
     columns = np.array([[slot.get(int(a), -1) for a in pair] for pair in recording.pairs], dtype=np.int64).reshape(-1, 2)
     with path.open("wb") as f:

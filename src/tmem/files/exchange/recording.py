@@ -8,6 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from tmem.files.exchange.attitude import attitude_quaternion, body_attitude
 from tmem.files.trajectory_file import (
     RunReadError, check_layout, components, open_trajectory, over_time, positions, reading, run_axes, trajectory_path,
 )  # fmt: skip
@@ -30,6 +31,9 @@ class Recording(NamedTuple):
         Positions (m) in the run's local frame; 0 on the axes the run does not have.
     tilts : ndarray, shape (n_times, n_agents, 2)
         Tilts ``phi_x``, ``phi_y`` (rad); 0 on the axes the run does not have.
+    attitude : ndarray, shape (n_times, n_agents, 4)
+        The attitude ``(qw, qx, qy, qz)``: the body attitude the run recorded, where it has one (a
+        quadrotor's), else the one the tilts define (:mod:`tmem.files.exchange.attitude`).
     active : ndarray, shape (n_times, n_agents), bool
         Whether each agent was flying.
     pairs : ndarray, shape (n_pairs, 2)
@@ -53,6 +57,7 @@ class Recording(NamedTuple):
     names: list[str]
     positions: np.ndarray
     tilts: np.ndarray
+    attitude: np.ndarray
     active: np.ndarray
     pairs: np.ndarray
     flags: np.ndarray
@@ -80,6 +85,17 @@ def _padded(values: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
+#: A recorded body attitude's variables (:data:`tmem.vehicles.quadrotor.BODY_NAMES`).
+QUATERNION = ("q_x", "q_y", "q_z", "q_w")
+
+
+def _attitude(ds, tilts: np.ndarray) -> np.ndarray:
+    """The recorded body attitude where the run has one, else the tilts' (time, agent, 4)."""
+    if all(name in ds.variables for name in QUATERNION):
+        return body_attitude(*(over_time(ds, name) for name in QUATERNION))
+    return attitude_quaternion(tilts[..., 0], tilts[..., 1])
+
+
 def _read(path: Path) -> Recording:
     with open_trajectory(path) as ds:
         if not str(ds.attrs.get("source", "")).startswith("tmem ") or "scenario" not in ds.attrs:
@@ -88,12 +104,14 @@ def _read(path: Path) -> Recording:
         if ds.sizes["agent"] == 0:
             raise RunReadError(f"export: {path}: the run recorded no agent (simulation.record_agents = []); nothing to export")
         scenario = str(ds.attrs["scenario"])
+        tilts = _padded(components(ds, "phi"), 2)
         return Recording(
             time=ds["time"].values.astype(float),
             agents=ds["agent"].values.astype(np.int64),
             names=[str(name) for name in ds["agent_name"].values],
             positions=_padded(positions(ds), 3),
-            tilts=_padded(components(ds, "phi"), 2),
+            tilts=tilts,
+            attitude=_attitude(ds, tilts),
             active=over_time(ds, "active").astype(bool),
             pairs=np.stack([ds["pair_i"].values, ds["pair_j"].values], axis=-1).astype(np.int64).reshape(-1, 2),
             flags=over_time(ds, "F_en").astype(np.int8),

@@ -3,7 +3,8 @@
 import { decode, frameAt, FLYING, REMOVED } from 'tmem/run';
 import { Charts } from 'tmem/charts';
 import { WebGLRenderer } from 'three';
-import { COLOURS, niceStep, Scene } from 'tmem/scene';
+import { COLOURS, Scene } from 'tmem/scene';
+import { niceStep } from 'tmem/axes';
 
 const $ = (id) => document.getElementById(id);
 const timing = { scripts: performance.now() }; // ms from the start of navigation
@@ -20,6 +21,8 @@ function fillHeader() {
     dd.textContent = value;
     $('headline').append(dt, dd);
   }
+  $('caveat').textContent = run.caveat;
+  $('caveat').hidden = !run.caveat;
   $('note').textContent = run.note;
   $('note').hidden = !run.note;
   $('sphere-label').textContent = `interaction ${run.D === 3 ? 'spheres' : 'circles'} (R = ${run.radius} m)`;
@@ -165,6 +168,8 @@ window.tmemViewer = {
   },
   // Screen positions (px in the view) of the agents drawn.
   screen() { return scene ? Array.from(scene.shown.subarray(0, scene.shownCount), (a) => scene.screen(a).slice(0, 2)) : []; },
+  // The axes' text drawn over the view: {axis, value (null for a name), text, x, y} (px in the view).
+  axes() { return scene ? scene.axisTexts.map((t) => ({ ...t })) : []; },
   spheresShown() { return Boolean(scene?.spheres.visible && scene.spheres.count); },
   cursors() { return charts.cursorPositions(); },
   timing,

@@ -1,10 +1,12 @@
 // The swarm drawn with three.js: agents, interaction spheres (circles in 1-D and 2-D) of radius R,
 // formation edges coloured by strain, removed agents, the box and obstacles; orbit (3-D) or pan
-// (1-D, 2-D) and zoom; agent numbers and the agent under the pointer.
+// (1-D, 2-D) and zoom; agent numbers and the agent under the pointer; the axes: in 1-D and 2-D a
+// grid with its values along the edges of the view, in 3-D each axis named along the frame.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls';
 import { edgeQuads, STRAIN_COLOURS, strainColour } from 'tmem/edges';
 import { FLYING, REMOVED, WAITING } from 'tmem/run';
+import { axisTexts, gridArea, gridPoints, placeTexts, visibleArea } from 'tmem/axes';
 
 export const COLOURS = {
   agent: '#1f77b4', removed: '#7f7f7f', sphere: '#1f77b4', frame: '#b8b8b8', box: '#555555', obstacle: '#999999',
@@ -32,12 +34,6 @@ const CROSS = () => sprite((g) => {
   g.beginPath(); g.moveTo(10, 10); g.lineTo(54, 54); g.moveTo(54, 10); g.lineTo(10, 54); g.stroke();
 });
 
-// A step of 1, 2 or 5 times a power of ten near `span`.
-export function niceStep(span) {
-  const p = 10 ** Math.floor(Math.log10(span));
-  return [1, 2, 5, 10].map((m) => m * p).find((s) => s >= span) ?? 10 * p;
-}
-
 function points(count, size, texture, colour) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * count), 3));
@@ -64,6 +60,9 @@ export class Scene {
     this.shownCount = 0;
     this.follow = false;
     this.labels = [];
+    this.axesLayer = document.createElement('div');
+    this.axesLayer.id = 'axes';
+    container.append(this.axesLayer);
     this.bounds = this.#bounds();
     this.#camera();
     this.#drawStatic();
@@ -129,13 +128,6 @@ export class Scene {
       const light = new THREE.DirectionalLight('#ffffff', 1.6);
       light.position.set(1, -1, 2);
       this.scene.add(light);
-    } else {
-      this.gridStep = niceStep((b.max.x - b.min.x) / 8);
-      const v = [];
-      const s = this.gridStep;
-      for (let x = Math.ceil(b.min.x / s) * s; x <= b.max.x; x += s) v.push(new THREE.Vector3(x, b.min.y, -1), new THREE.Vector3(x, b.max.y, -1));
-      for (let y = Math.ceil(b.min.y / s) * s; y <= b.max.y; y += s) v.push(new THREE.Vector3(b.min.x, y, -1), new THREE.Vector3(b.max.x, y, -1));
-      this.scene.add(lines(v, '#eeeeee'));
     }
     if (space.box) {
       const box = new THREE.Box3(new THREE.Vector3(), this.#point(space.box));
@@ -299,9 +291,7 @@ export class Scene {
 
   // Screen position (CSS px in the canvas) of agent column a at the frame shown.
   screen(a, out = new THREE.Vector3()) {
-    const { clientWidth: w, clientHeight: h } = this.renderer.domElement;
-    this.at(this.frame, a, out).project(this.camera);
-    return [(out.x + 1) / 2 * w, (1 - out.y) / 2 * h, out.z];
+    return this.#onScreen(this.at(this.frame, a, out));
   }
 
   // The agent column drawn nearest (x, y), within PICK_PX, or -1.
@@ -316,9 +306,38 @@ export class Scene {
   }
 
   render() {
+    if (this.run.D < 3) this.#grid();
     this.renderer.render(this.scene, this.camera);
     this.#placeLabels();
+    this.#placeAxes();
     this.onRender?.();
+  }
+
+  // The world rectangle the orthographic view (1-D, 2-D) shows, and the grid's step for it.
+  visible() { return visibleArea(this.camera); }
+
+  // Grid lines at the step of the view shown, over three times its area, drawn again when the step
+  // changes or the view leaves that area.
+  #grid() {
+    const area = gridArea(this.visible(), this.gridArea);
+    if (area === this.gridArea) return;
+    if (this.gridLines) { this.scene.remove(this.gridLines); this.gridLines.geometry.dispose(); }
+    this.gridLines = lines(gridPoints(area), '#eeeeee');
+    this.scene.add(this.gridLines);
+    this.gridArea = area;
+  }
+
+  #placeAxes() {
+    const { clientWidth: w, clientHeight: h } = this.container;
+    this.axisTexts = axisTexts(this.run, this.bounds, this.visible(), w, h, (p) => this.#onScreen(p));
+    placeTexts(this.axesLayer, this.axisTexts);
+  }
+
+  // Screen position (CSS px in the canvas) and depth of world point p.
+  #onScreen(p) {
+    const { clientWidth: w, clientHeight: h } = this.renderer.domElement;
+    const q = p.clone().project(this.camera);
+    return [(q.x + 1) / 2 * w, (1 - q.y) / 2 * h, q.z];
   }
 
   #placeLabels() {
