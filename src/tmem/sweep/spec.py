@@ -71,6 +71,8 @@ SCALAR_METRICS = (
     "rms_velocity_initial",
     "rms_velocity_final",
     "rms_change_percent",
+    "rms_change_peak_percent",
+    "rms_change_peak_time",
     "min_distance",
     "final_distance",
     "coupled",
@@ -90,6 +92,7 @@ _FORMATION_KEYS = (
 )
 _GAS_KEYS = (
     "rms_velocity|kinetic_energy_per_axis|density|pressure_virial|pressure_walls|pressure_wall_range"
+    "|pressure_virial_walls|pressure_agreement_percent"
     "|pressure_ideal|encounter_rate|mean_free_path|breaches"
 )
 _COVERAGE_KEYS = "share_final|time_to_50|time_to_90"
