@@ -114,7 +114,7 @@ def test_a_message_from_a_non_neighbour_beyond_reach_changes_nothing_and_within_
 def _pair(**changes):
     """Two agents 35 m apart by hand, coupled, agent 1 at rest and agent 0 closing at 1 m/s."""
     gains = tmem.modal_gains(6.0, 25.0, 9.8, 12.0, 0.1, 0.55)
-    settings = {"dt": 1e-3, "function": "improved", **changes}
+    settings = {"dt": 1e-3, "law": {"function": "improved"}, **changes}
     controllers = [AgentController(0, gains, edges=[Edge(neighbour=1, coupled=True)], **settings),
                    AgentController(1, gains, edges=[Edge(neighbour=0, coupled=True)], **settings)]  # fmt: skip
     states = np.zeros((2, 1, 4))
@@ -177,19 +177,19 @@ BAD = [
     ({"gains": [-1.0] + GAINS[1:]}, "gains[0]"),
     ({"gains": GAINS[:3] + [float("nan")]}, "gains[3]"),
     ({"dt": 0.0}, "dt"),
-    ({"function": "spring"}, "function"),
-    ({"d_t": 45.0}, "d_t"),
-    ({"eps": 40.0, "d_t": 35.0}, "eps"),
+    ({"law": {"function": "spring"}}, "law.function"),
+    ({"law": {"d_t": 45.0}}, "law.d_t"),
+    ({"law": {"eps": 40.0, "d_t": 35.0}}, "law.eps"),
     ({"edges": [Edge(neighbour=0)]}, "edges[0].neighbour"),
     ({"edges": [Edge(neighbour=1), Edge(neighbour=1)]}, "edges[1].neighbour"),
     ({"edges": [{"neighbour": 1, "d_t": -3.0}]}, "edges[0].d_t"),
     ({"edges": [Edge(neighbour=1, direction=[1.0, 0.0])]}, "edges[0].direction"),
     ({"axes": 2, "edges": [Edge(neighbour=1, direction=[1.0, 1.0])]}, "edges[0].direction"),
     ({"commands": [OperatorCommand(time=1.0, action="uncouple", pairs=[[2, 3]])]}, "commands[0].pairs"),
-    ({"uncouple_when": "energy"}, "fallback_time"),
+    ({"law": {"uncouple_when": "energy"}}, "law.fallback_time"),
     ({"order": [1, 2, 1]}, "order"),
     ({"max_age": -1.0}, "max_age"),
-    ({"switch_at": "middle"}, "switch_at"),
+    ({"law": {"switch_at": "middle"}}, "law.switch_at"),
 ]
 
 

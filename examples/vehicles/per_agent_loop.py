@@ -59,7 +59,7 @@ class SimulatedVehicle:
         self.state = start[np.newaxis].copy()  # the model's step works on an array of agents: here one
         self.body = model.initial_body(self.state)
         self.setpoint = np.zeros((1, start.shape[0]))
-        self._step, self._hold = type(model).step, model.step_params(dt)
+        self._step, self._hold = model.kernel(), model.step_params(dt)
 
     def state_estimate(self) -> np.ndarray:
         return self.state[0]  # a real vehicle: its state estimator's output

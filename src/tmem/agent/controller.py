@@ -29,14 +29,14 @@ from numbers import Real
 import numpy as np
 
 from tmem.engine.driver import read_events
+from tmem.law.params import ControllerLaw
 from tmem.law.record import law_record
 from tmem.engine.records import COMMANDS, Events
 from tmem.engine.stages import command_pair
 from tmem.engine.trajectory import Event
-from tmem.law.interaction.kernels import FunctionParams
-from tmem.agent.kernel import PAIR_FLOATS, PAIR_INTS, control, events_from, law_tables, message_vectors, pairs_from
+from tmem.agent.kernel import PAIR_FLOATS, PAIR_INTS, control, events_from, message_vectors, pairs_from
 from tmem.agent.messages import AgentMessage
-from tmem.agent.settings import DEFAULTS, ControllerError, ControllerSettings, Edge, OperatorCommand
+from tmem.agent.settings import ControllerError, ControllerSettings, Edge, OperatorCommand
 
 #: Where the number of events logged in an update is kept (:class:`tmem.engine.records.Counters`).
 _N_EVENTS = 3
@@ -57,29 +57,11 @@ class AgentController:
         and the energy rule's fallback are counted in ticks.
     axes : int
         Horizontal axes, 1 to 3.
-    function : str
-        The interaction function of the formation pairs: ``"repulsion"`` (8), ``"attraction"``
-        (Fig. 3), ``"switching"`` (10) or ``"improved"`` (11).  The other neighbours push with
-        it, or with the repulsion (8) if it switches on ``F_en``.
-    reach : float
-        ``R + R_j`` (m): agents closer than that in ``P*`` interact.
-    c_max : float
-        The tilt limit (rad): ``|U| <= c_max``.
-    d_t : float
-        The set distance (m), of the edges that give none and of the attraction.
-    eps : float
-        The coupling window of (9) (m).
-    switch_at : str
-        ``"window"`` or ``"crossing"``: where the flag flips (:mod:`tmem.law.coupling`).
-    uncouple_when : str
-        ``"window"`` (9) or ``"energy"`` (the paper's energy match, :mod:`tmem.law.coupling`).
-    energy_tolerance : float
-        The energy rule's relative tolerance.
-    fallback_time : float or None
-        With the energy rule, how long after an uncouple command (9) takes over (s).
-    sync_gain : float
-        ``k_s`` of the speed synchronisation (S2) (rad per m/s; :func:`tmem.law.synchronise.synchronising_gain`);
-        0: none.
+    law : ControllerLaw or dict
+        The law's parameters (:class:`tmem.law.params.ControllerLaw`: the function, ``c_max``,
+        ``d_t``, ``eps``, the coupling rules, the reach, the energy rule's fallback time and the
+        synchronising gain), or a dict of them; default: the scenario's defaults.  ``d_t`` is that
+        of the edges that give none, and of the attraction.
     edges : sequence of Edge
         The formation edges: neighbour, ``d_t``, the direction to hold, ``F_en`` at the start.
         Their pulls are added in this order, after the other neighbours' pushes (the engine's:
@@ -107,18 +89,13 @@ class AgentController:
         couplings and uncouplings (agents named by id, the lower first).
     """
 
-    def __init__(self, agent: int, gains, *, dt: float, axes: int = 1, function: str = DEFAULTS.function,
-                 reach: float = DEFAULTS.reach, c_max: float = DEFAULTS.c_max, d_t: float = DEFAULTS.d_t,
-                 eps: float = DEFAULTS.eps, switch_at: str = DEFAULTS.switch_at, uncouple_when: str = DEFAULTS.uncouple_when,
-                 energy_tolerance: float = DEFAULTS.energy_tolerance, fallback_time: float | None = None,
-                 sync_gain: float = 0.0, edges: Sequence[Edge] = (), commands: Sequence[OperatorCommand] = (),
-                 order: Sequence[int] | None = None, max_age: float | None = None):  # fmt: skip
+    def __init__(self, agent: int, gains, *, dt: float, axes: int = 1, law: ControllerLaw | dict | None = None,
+                 edges: Sequence[Edge] = (), commands: Sequence[OperatorCommand] = (), order: Sequence[int] | None = None,
+                 max_age: float | None = None):  # fmt: skip
         gains = list(gains) if isinstance(gains, Iterable) else gains
         self.settings = ControllerSettings(
-            agent=agent, gains=gains, dt=dt, axes=axes, function=function, reach=reach, c_max=c_max, d_t=d_t, eps=eps,
-            switch_at=switch_at, uncouple_when=uncouple_when, energy_tolerance=energy_tolerance,
-            fallback_time=fallback_time, sync_gain=sync_gain, edges=list(edges), commands=list(commands),
-            order=None if order is None else list(order), max_age=max_age,
+            agent=agent, gains=gains, dt=dt, axes=axes, law=ControllerLaw() if law is None else law, edges=list(edges),
+            commands=list(commands), order=None if order is None else list(order), max_age=max_age,
         )  # fmt: skip
         self._build()
         self.reset()
@@ -127,10 +104,8 @@ class AgentController:
         """The arrays of the law, of the agent's view of its neighbours and of its edges."""
         s = self.settings
         self._gains = np.array(s.gains, dtype=float)[np.newaxis, :]
-        fallback = 0 if s.fallback_time is None else int(round(s.fallback_time / s.dt))
-        law = law_record(self._gains[0], s.function, s.switch_at, s.eps, s.uncouple_when, s.energy_tolerance, fallback,
-                         s.sync_gain)  # fmt: skip
-        self._law = law_tables(law, FunctionParams(self._gains[0, 0], s.reach, s.d_t, s.c_max))
+        fallback = 0 if s.law.fallback_time is None else int(round(s.law.fallback_time / s.dt))
+        self._law = law_record(s.law, self._gains[0], fallback, s.law.sync_gain)
         self._ids = np.array([s.agent] + [edge.neighbour for edge in s.edges], dtype=np.int64)
         self._row = {int(n): row for row, n in enumerate(self._ids) if row > 0}
         n_edges, axes = len(self._ids) - 1, s.axes
@@ -174,7 +149,7 @@ class AgentController:
         for row, name in enumerate(PAIR_INTS):
             self._pair_ints[row] = start[name]
         self._pair_floats[:] = np.nan
-        self._pair_floats[PAIR_FLOATS.index("d_t")] = [s.d_t if edge.d_t is None else edge.d_t for edge in s.edges]
+        self._pair_floats[PAIR_FLOATS.index("d_t")] = [s.law.d_t if edge.d_t is None else edge.d_t for edge in s.edges]
         self._pair_floats[PAIR_FLOATS.index("min_distance")] = np.inf
         for e, (edge, low) in enumerate(zip(s.edges, lower)):  # held from i to j; the edge gives it from this agent
             if edge.direction is not None:
@@ -238,7 +213,7 @@ class AgentController:
         self._carry_out_commands(k)
         others = self._read(messages, t)
         self._counts[_N_EVENTS] = 0
-        control(k, own, self._gains, *self._law, self._inbox, self._known, self._active, self._corrected, self._setpoint,
+        control(k, own, *self._law, self._inbox, self._known, self._active, self._corrected, self._setpoint,
                 self._pair_ints, self._pair_floats, self._direction, self._pairs.d, self._heard, others, self._event_table,
                 self._counts, self._box, self._out)  # fmt: skip
         if self._counts[_N_EVENTS]:

@@ -23,10 +23,11 @@ second agent the engine takes it the other way and subtracts the push, and
 ``x - y * f`` is ``x + (-y) * f`` to the bit, so each agent's sum is the
 engine's.
 
-The records travel to the compiled code as arrays and are rebuilt there
-(:func:`law_from`, :func:`pairs_from`): passed from Python, a record of
-numbers costs about 10 us per call to unpack, an array about half a
-microsecond, and an update is called for every agent at every step.
+The law travels to the compiled code as its records (:class:`tmem.law.record.Law`,
+:class:`tmem.law.interaction.kernels.FunctionParams`); the edges' and the events' records travel
+as a few arrays and are rebuilt there (:func:`pairs_from`, :func:`events_from`): passed from
+Python, a record of fourteen arrays cost 3 us per call to unpack, its three tables 1 us, and an
+update is called for every agent at every step.
 """
 
 from __future__ import annotations
@@ -38,48 +39,11 @@ from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before a
 from tmem.law.modal import corrected_position, tilt_scale
 from tmem.engine.pairs import formation_pair
 from tmem.engine.records import Agents, Counters, Events, Pairs
-from tmem.law.record import Law
 from tmem.law.interaction.kernels import FunctionParams, push_factor
 
-#: The integer and the real numbers of the law (:class:`tmem.law.record.Law` and
-#: :class:`tmem.law.interaction.kernels.FunctionParams`), in their rows of :func:`law_tables`.
-LAW_INTS = ("function", "neighbour_function", "couples", "at_crossing", "uncouple_rule", "fallback_steps")
-LAW_FLOATS = ("eps", "energy_tolerance", "sync_gain", "k_p", "reach", "d_t", "c_max")
 #: The rows of the edges' tables: the integer and the real columns of :class:`tmem.engine.records.Pairs`.
 PAIR_INTS = ("i", "j", "flag", "armed", "disarmed_at")
 PAIR_FLOATS = ("d_t", "r_before", "min_distance", "coupled_gap", "coupled_energy", "entry_speed2", "kept_speed2")
-
-
-def law_tables(law: Law, params: FunctionParams) -> tuple[np.ndarray, np.ndarray]:
-    """The law's numbers as the arrays :func:`law_from` reads: ``(ints, floats)`` in the orders
-    :data:`LAW_INTS` and :data:`LAW_FLOATS`.
-
-    Parameters
-    ----------
-    law : Law
-        The TMEM law (its gains travel apart).
-    params : FunctionParams
-        The interaction functions' parameters.
-    """
-    ints = np.array([int(getattr(law, name)) for name in LAW_INTS], dtype=np.int64)
-    floats = np.array([getattr(law, name) if name in Law._fields else getattr(params, name) for name in LAW_FLOATS])
-    return ints, floats
-
-
-@numba.njit(cache=True, inline="always")
-def law_from(gains, ints, floats):
-    """The :class:`~tmem.law.record.Law` and :class:`~tmem.law.interaction.kernels.FunctionParams`
-    held in the arrays of :func:`law_tables`.
-
-    Parameters
-    ----------
-    gains : ndarray, shape (1, 4)
-        The agent's ``K``.
-    ints, floats : ndarray
-        The law's numbers, in the orders :data:`LAW_INTS` and :data:`LAW_FLOATS`.
-    """
-    law = Law(gains, ints[0], ints[1], ints[2] != 0, ints[3] != 0, floats[0], ints[4], floats[1], ints[5], floats[2])
-    return law, FunctionParams(floats[3], floats[4], floats[5], floats[6])
 
 
 @numba.njit(cache=True, inline="always")
@@ -139,8 +103,8 @@ def message_vectors(own, gains, out):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def control(k, own, gains, law_ints, law_floats, inbox, known, active, corrected, setpoint, pair_ints, pair_floats, direction,
-            d, heard, others, event_table, counts, box, out):  # fmt: skip
+def control(k, own, law, params, inbox, known, active, corrected, setpoint, pair_ints, pair_floats, direction, d, heard,
+            others, event_table, counts, box, out):  # fmt: skip
     """One update of one agent at step ``k``: its saturated tilt set-point into ``out`` (see the module text).
 
     Parameters
@@ -149,8 +113,10 @@ def control(k, own, gains, law_ints, law_floats, inbox, known, active, corrected
         The step (the update's tick).
     own : ndarray, shape (axes, n_state)
         The agent's own state.
-    gains, law_ints, law_floats : ndarray
-        The law (:func:`law_from`).
+    law : Law
+        The TMEM law (:func:`tmem.law.record.law_record`), the agent's gains in its one row.
+    params : FunctionParams
+        The interaction functions' parameters.
     inbox : ndarray, shape (neighbours + 1, 3, axes)
         Row ``e + 1``: ``P*``, ``P`` and ``V`` of the last message of the ``e``-th formation neighbour.
     known, active, corrected, setpoint : ndarray
@@ -171,7 +137,6 @@ def control(k, own, gains, law_ints, law_floats, inbox, known, active, corrected
     out : ndarray, shape (axes,)
         Filled with ``U`` (rad), ``|U| <= c_max``.
     """
-    law, params = law_from(gains, law_ints, law_floats)
     no_body = setpoint[:, :0]  # the pair rules read no body state: a view with no columns, nothing allocated
     agents = Agents(known, known, active, corrected, setpoint, no_body, no_body)
     pairs = pairs_from(pair_ints, pair_floats, direction, d)
@@ -180,7 +145,7 @@ def control(k, own, gains, law_ints, law_floats, inbox, known, active, corrected
     for a in range(n_axes):
         for m in range(known.shape[2]):  # (P, V, phi, omega): what the law reads of a state
             known[0, a, m] = own[a, m]
-        corrected[0, a, 0] = corrected_position(known, 0, a, gains, 0)
+        corrected[0, a, 0] = corrected_position(known, 0, a, law.gains, 0)
         corrected[0, a, 1] = own[a, 0]
         setpoint[0, a] = 0.0
         for row in range(1, inbox.shape[0]):

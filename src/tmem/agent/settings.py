@@ -15,12 +15,10 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from tmem.law.interaction.registry import FUNCTION_NAMES
+from tmem.law.params import ControllerLaw
 from tmem.scenario.files import describe
-from tmem.scenario.tables import FieldError, InteractionParams, NonNegative, Number, Pair, Positive, StrictModel
+from tmem.scenario.fields import FieldError, NonNegative, Number, Pair, Positive, StrictModel
 
-#: The scenario's ``[interaction]`` defaults, which the controller's are.
-DEFAULTS = InteractionParams()
 #: How far from 1 the length of an edge's direction may be (the engine's come from a division).
 UNIT_TOLERANCE = 1e-9
 
@@ -108,18 +106,8 @@ class ControllerSettings(_Checked):
         The update period (s).
     axes : int
         Horizontal axes, 1 to 3.
-    function : str
-        The interaction function of its formation pairs.
-    reach, c_max, d_t, eps : float
-        ``R + R_j`` (m), the tilt limit (rad), the set distance (m), the coupling window (9) (m).
-    switch_at, uncouple_when : str
-        Where the flag flips, and the uncoupling rule (:mod:`tmem.law.coupling`).
-    energy_tolerance : float
-        The energy rule's relative tolerance.
-    fallback_time : float or None
-        After an uncouple command, when the energy rule falls back on (9) (s).
-    sync_gain : float
-        ``k_s`` of the speed synchronisation (S2) (rad per m/s); 0: none.
+    law : ControllerLaw
+        The law's parameters (:class:`tmem.law.params.ControllerLaw`), checked as a scenario's are.
     edges : list of Edge
     commands : list of OperatorCommand
     order : list of int or None
@@ -134,16 +122,7 @@ class ControllerSettings(_Checked):
     gains: Annotated[list[Number], Field(min_length=4, max_length=4)]
     dt: Annotated[float, Field(ge=1e-9, le=1e9)]
     axes: Literal[1, 2, 3] = 1
-    function: Literal[FUNCTION_NAMES] = DEFAULTS.function
-    reach: Positive = DEFAULTS.reach
-    c_max: Positive = DEFAULTS.c_max
-    d_t: Positive = DEFAULTS.d_t
-    eps: Positive = DEFAULTS.eps
-    switch_at: Literal["window", "crossing"] = DEFAULTS.switch_at
-    uncouple_when: Literal["window", "energy"] = DEFAULTS.uncouple_when
-    energy_tolerance: Annotated[float, Field(gt=0, lt=1)] = DEFAULTS.energy_tolerance
-    fallback_time: Positive | None = None
-    sync_gain: NonNegative = 0.0
+    law: ControllerLaw = ControllerLaw()
     edges: list[Edge] = []
     commands: list[OperatorCommand] = []
     order: list[Annotated[int, Field(ge=0)]] | None = None
@@ -153,13 +132,6 @@ class ControllerSettings(_Checked):
     def _consistent(self) -> "ControllerSettings":
         if not self.gains[0] > 0.0:
             raise FieldError("gains[0]", f"K_P must be > 0 (P* (6) is divided by it), got {self.gains[0]:g}")
-        if self.d_t >= self.reach:
-            raise FieldError("d_t", f"must be less than reach = {self.reach:g} m (condition (9)), got {self.d_t:g}")
-        if self.eps >= self.d_t:
-            raise FieldError("eps", f"must be less than d_t = {self.d_t:g} m, got {self.eps:g}")
-        if self.uncouple_when == "energy" and self.fallback_time is None:
-            raise FieldError("fallback_time", "is required with uncouple_when = 'energy' "
-                             "(one period of the coupled pair's slow mode)")  # fmt: skip
         self._check_edges()
         self._check_commands()
         if self.order is not None and len(set(self.order)) != len(self.order):
@@ -174,8 +146,8 @@ class ControllerSettings(_Checked):
             if edge.neighbour in seen:
                 raise FieldError(f"edges[{k}].neighbour", f"repeats the edge to agent {edge.neighbour}")
             seen.add(edge.neighbour)
-            if edge.d_t is not None and edge.d_t >= self.reach:
-                raise FieldError(f"edges[{k}].d_t", f"must be less than reach = {self.reach:g} m, got {edge.d_t:g}")
+            if edge.d_t is not None and edge.d_t >= self.law.reach:
+                raise FieldError(f"edges[{k}].d_t", f"must be less than reach = {self.law.reach:g} m, got {edge.d_t:g}")
             if edge.direction is not None:
                 where, length = f"edges[{k}].direction", math.hypot(*edge.direction)
                 if len(edge.direction) != self.axes:

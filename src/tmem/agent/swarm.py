@@ -30,6 +30,7 @@ from tmem.world.initial import build
 from tmem.vehicles import vehicle_model
 from tmem.scenario import Scenario
 from tmem.agent.controller import AgentController
+from tmem.law.params import ControllerLaw, LawParams
 from tmem.agent.settings import ControllerError, Edge, OperatorCommand
 
 #: Most agents :func:`controllers_for` builds: every controller reads every agent's message, so a
@@ -109,11 +110,11 @@ def controllers_for(scenario: Scenario) -> list[AgentController]:
             commands[a].append(OperatorCommand(time=command.time, action=command.action, pairs=named))
     order = slot_order(scenario, initial, gains).tolist()
     fallback = law.fallback_steps * sim.dt if ia.uncouple_when == "energy" else None
+    shared = {name: getattr(ia, name) for name in LawParams.model_fields}  # the law's parameters, declared once
+    agent_law = ControllerLaw(**shared, reach=ia.reach, fallback_time=fallback, sync_gain=law.sync_gain)
     return [
-        AgentController(a, gains, dt=sim.dt, axes=scenario.space.axes, function=ia.function, reach=ia.reach,
-                        c_max=ia.c_max, d_t=ia.d_t, eps=ia.eps, switch_at=ia.switch_at, uncouple_when=ia.uncouple_when,
-                        energy_tolerance=ia.energy_tolerance, fallback_time=fallback, sync_gain=law.sync_gain,
-                        edges=edges[a], commands=commands[a], order=order)  # fmt: skip
+        AgentController(a, gains, dt=sim.dt, axes=scenario.space.axes, law=agent_law, edges=edges[a], commands=commands[a],
+                        order=order)  # fmt: skip
         for a in range(n)
     ]
 

@@ -18,7 +18,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
-from tmem.law.interaction.registry import FUNCTION_NAMES
+from tmem.law.params import LawParams
 from tmem.scenario.fields import (  # noqa: F401  (the tables' types, importable from here too)
     LIMIT, FieldError, NonNegative, Number, Pair, Positive, ScenarioError, StrictModel, per_axis,
 )
@@ -62,29 +62,19 @@ class ControllerParams(StrictModel):
         return v
 
 
-class InteractionParams(StrictModel):
-    """Interaction function and its parameters, (7)-(11), and how coupled pairs behave.
+class InteractionParams(LawParams):
+    """Interaction function and its parameters, (7)-(11), and how coupled pairs behave: the law's
+    parameters (:class:`tmem.law.params.LawParams`, with their checks) and what a scenario adds.
 
-    ``uncouple_when``: after an uncouple command, a pair lets go at the first
-    moment (9) holds (``"window"``), or where its relative kinetic energy and
-    ``f1 - f2`` match their values at coupling, within ``energy_tolerance``
-    (``"energy"``, :mod:`tmem.law.coupling`).  ``synchronise``: a coupled pair
-    damps its relative motion (its slow mode's damping ratio
-    ``sync_damping``) and puts the energy into its common motion
-    (:mod:`tmem.law.synchronise`).  ``combine``: an agent's pushes of several
-    neighbours are summed (``"sum"``, the paper's reading) or averaged over
-    the neighbours, walls and obstacles within reach (``"mean"``, which keeps
-    each agent's loop ``A - B K`` in crowds: :mod:`tmem.engine.gas`).
+    ``radius``: ``R = R_j``, so that the reach is ``R + R_j = 2 R``.  ``synchronise``: a coupled
+    pair damps its relative motion (its slow mode's damping ratio ``sync_damping``) and puts the
+    energy into its common motion (:mod:`tmem.law.synchronise`).  ``combine``: an agent's pushes of
+    several neighbours are summed (``"sum"``, the paper's reading) or averaged over the neighbours,
+    walls and obstacles within reach (``"mean"``, which keeps each agent's loop ``A - B K`` in
+    crowds: :mod:`tmem.engine.gas`).
     """
 
-    function: Literal[FUNCTION_NAMES] = "improved"
     radius: Positive = 20.0
-    c_max: Positive = 0.1
-    d_t: Positive = 35.0
-    eps: Positive = 0.2
-    switch_at: Literal["window", "crossing"] = "window"
-    uncouple_when: Literal["window", "energy"] = "window"
-    energy_tolerance: Annotated[float, Field(gt=0, lt=1)] = 0.05
     synchronise: bool = False
     sync_damping: Annotated[float, Field(gt=0, lt=1)] = 0.7
     combine: Literal["sum", "mean"] = "sum"
@@ -93,14 +83,6 @@ class InteractionParams(StrictModel):
     def reach(self) -> float:
         """``R + R_j``: the distance below which two agents interact."""
         return 2.0 * self.radius
-
-    @model_validator(mode="after")
-    def _coupling_inside_reach(self) -> "InteractionParams":
-        if self.d_t >= self.reach:
-            raise FieldError("d_t", f"must be less than R + R_j = {self.reach:g} m (condition (9)), got {self.d_t:g}")
-        if self.eps >= self.d_t:
-            raise FieldError("eps", f"must be less than d_t = {self.d_t:g} m, got {self.eps:g}")
-        return self
 
 
 class SimulationParams(StrictModel):
