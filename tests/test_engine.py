@@ -141,7 +141,7 @@ def test_each_agent_corrected_position_uses_its_own_gains():
     run = Run(10, 1, (0.0,) * axes, False, 1.0)
     neighbours = Neighbours(np.empty((0, 2), dtype=np.uint32), 0, 0, np.zeros(2, dtype=np.int64), np.zeros((n, axes)),
                             np.empty(1), np.empty(2), np.full(1, np.inf), np.empty((2, 2 * axes + 1, 8)))  # fmt: skip
-    corrected_positions(state, agents, law, run, neighbours, gas_record(tmem.preset("fig9"), 9.8, n, 1.0), 0, False)  # lists of P*
+    corrected_positions(state, agents, law, run, neighbours, gas_record(tmem.preset("fig9"), 9.8, n), 0, False)  # lists of P*
     expected = np.stack([interaction_point(state[i], gains[i]) for i in range(n)])
     np.testing.assert_allclose(agents.corrected[:, :, 0], expected, rtol=1e-13)
     np.testing.assert_array_equal(agents.corrected[:, :, 1], state[:, :, 0])

@@ -6,3 +6,7 @@
 * :mod:`tmem.analysis.coverage` — the share of a walled box the swarm visits;
 * :mod:`tmem.analysis.reference` — the same closed loop integrated in continuous time, to test the engine against.
 """
+
+from tmem._lazy import submodules
+
+__getattr__ = submodules(__name__)

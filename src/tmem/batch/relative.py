@@ -23,7 +23,6 @@ import numpy as np
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.law import coupling
 from tmem.batch.free_flight import level, steps_before_contact
-from tmem.law.modal import corrected_position
 from tmem.law.interaction.kernels import pair_control
 from tmem.vehicles.linear import LinearModel
 
@@ -132,7 +131,11 @@ def run_relative(e0, n_steps, dt, command_step, hold, law, params, e_end, min_di
                 running += 1
                 if k[c] == command_step:
                     armed[c] = 0
-                d = corrected_position(e, c, 0, gains, 0)
+                # P* (6) of the relative state, written out for the four states of (2): this loop is
+                # compiled with fused multiply-adds, and the sum written out fuses as it always has
+                # (tmem.law.modal.corrected_position's loop fuses otherwise: results 1e-12 apart).
+                d = (e[c, 0, 0] * gains[0, 0] + e[c, 0, 1] * gains[0, 1] + e[c, 0, 2] * gains[0, 2]
+                     + e[c, 0, 3] * gains[0, 3]) / gains[0, 0]  # fmt: skip
                 r = abs(d)
                 lowest[c] = min(lowest[c], abs(e[c, 0, 0]))
                 # Free flight: uncoupled, out of reach, level (the tilt has died out).  Then

@@ -78,7 +78,7 @@ REBUILT = {
         "block_nearest2": _WORK, "block_shift2": _WORK, "chunks": _WORK,
     },
     "gas": {
-        **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "every", "wall_reach", "k_p", "c_max"), _FIXED),
+        **dict.fromkeys(("observe", "mean", "rate", "inv_g", "g_dt", "dt", "every", "wall_reach", "c_max"), _FIXED),
         "work": _COUNTED, "pushed": _WORK,
     },
     "sensing": {

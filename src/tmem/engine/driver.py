@@ -217,7 +217,7 @@ def simulate(
     lister, measured, sensed = _lists_and_measurement(scenario, run, swarm, gains, sensing)
     terms = {name: term_class(name).record(getattr(scenario, name), scenario, gains) for name in scenario.agent_terms}
     stages = Stages(law=law, params=params, vehicle=model.step_params(sim.dt), knowledge=measured,
-                    gas=gas_record(scenario, model.acceleration_per_input(), x.shape[0], float(gains[0])), terms=terms)
+                    gas=gas_record(scenario, model.acceleration_per_input(), x.shape[0]), terms=terms)
     variant = Variant(vehicle=scenario.model.kind, knowledge="sensed" if sensed else "exact", terms=tuple(terms),
                       gas=stages.gas.observe, threaded=x.shape[0] >= THREADED_SWARM)  # fmt: skip
     _drive(advance_for(variant), run, stages, swarm, lister, progress, chunk_seconds, checkpoints, resume)

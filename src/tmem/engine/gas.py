@@ -35,7 +35,7 @@ from tmem.scenario import ThermostatParams
 from tmem.world.space import nearest_image
 from tmem.engine.gas_counts import COMMON, CONTACT, NEAR, NEIGHBOUR_VELOCITY, SPEED2, VIRIAL, count_pair, virial_by_pairs
 from tmem.engine.records import Gas
-from tmem.law.interaction.kernels import FunctionParams
+from tmem.law.interaction.kernels import with_reach
 from tmem.engine.thermostat import add_thermostat_push, hold_group_push
 from tmem.world.walls import keep_off, wall_pushes, with_priority
 
@@ -66,7 +66,7 @@ SNAPSHOT = tuple(COLUMNS)[len(TOTALS):]
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def gas_agent(i, known, agents, gas, box, counting, first):
+def gas_agent(i, known, agents, params, gas, box, counting, first):
     """Agent ``i``'s walls and obstacles (W1), thermostat (T1), (T3), then the walls' last word (W2),
     after every other push; at a count, the weights of the mean of pushes (C1), the thermostat's group
     push, and the neighbours that came within reach.  The gas's agent term: the last of the agent
@@ -80,6 +80,8 @@ def gas_agent(i, known, agents, gas, box, counting, first):
         The states as measured.
     agents, gas
         The loop's records (:mod:`tmem.engine.records`); ``agents.setpoint`` and ``gas`` change in place.
+    params : FunctionParams
+        The interaction functions' parameters: a wall's repulsion (8) is the law's, with ``R + R_w``.
     box : tuple of float
         The periodic box's sides (0: open axis).
     counting : bool
@@ -88,7 +90,7 @@ def gas_agent(i, known, agents, gas, box, counting, first):
         Whether it is the first count (the neighbours present at the start are not encounters).
     """
     corrected, setpoint = agents.corrected, agents.setpoint
-    wall_params = FunctionParams(gas.k_p, gas.wall_reach, 0.0, gas.c_max)  # the repulsion (8), with R + R_w
+    wall_params = with_reach(params, gas.wall_reach)  # the repulsion (8), with R + R_w
     n_axes = len(box)
     walls = gas.walls
     obstacles = gas.obstacles
@@ -229,7 +231,7 @@ def record_totals(agents, gas, records, q, n_axes):
             records.gas[q, n_totals + 1] += 1.0
 
 
-def gas_record(scenario, acceleration_per_tilt: float, n_agents: int, k_p: float) -> Gas:
+def gas_record(scenario, acceleration_per_tilt: float, n_agents: int) -> Gas:
     """The :class:`~tmem.engine.records.Gas` record of a scenario, with its work space for ``n_agents``.
 
     Parameters
@@ -240,8 +242,6 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int, k_p: float
         ``g``: the acceleration a tilt of one radian gives (``A[1, 2]`` of the vehicle's linearisation).
     n_agents : int
         Agents of the run.
-    k_p : float
-        ``K_P`` of the law: the walls' repulsion (8) pushes with it.
     """
     observe = scenario.gas_observed
     size = n_agents if observe else 0
@@ -263,7 +263,6 @@ def gas_record(scenario, acceleration_per_tilt: float, n_agents: int, k_p: float
         walls=walls,
         obstacles=obstacles,
         wall_reach=scenario.wall_reach,
-        k_p=k_p,
         c_max=scenario.interaction.c_max,
         first=np.ones(1, dtype=np.bool_),
         work=np.zeros((size, NEIGHBOUR_VELOCITY + space.axes)),

@@ -89,7 +89,7 @@ def _advance_source(k_stop, run, law, params, vehicle, knowledge, agents, pairs,
         for e in range(pairs.i.shape[0]):
             formation_pair(k, e, known, agents, pairs, law, params, run, events, counters, knowledge)  # noqa: F821
             count_pair(e, agents, pairs, law, params, run, gas, counting)  # noqa: F821  (bound)
-        agent_terms(k, known, agents, box, terms, gas, neighbours.block_shift2.shape[0], counting)  # noqa: F821
+        agent_terms(k, known, agents, params, box, terms, gas, neighbours.block_shift2.shape[0], counting)  # noqa: F821
         if is_recorded(k, run):
             record(agents, pairs, records, c_max, run, counters, gas, LISTED == 1)  # noqa: F821  (bound)
         if k < run.n_steps:

@@ -15,7 +15,7 @@ import numba
 import numpy as np
 
 from tmem.law import coupling
-from tmem.law.interaction.kernels import FunctionParams, pair_control
+from tmem.law.interaction.kernels import pair_control, with_d_t
 from tmem.world.space import nearest_image
 from tmem.law.synchronise import KEPT_TOLERANCE, mean_square_speed, synchronising_push
 from tmem.engine.stages import log_event
@@ -62,7 +62,7 @@ def _next_flag(k, e, r, energy, pairs, law, params):
     by (9), or by the energy match with its fallback on (9) (:mod:`tmem.law.coupling`).
     """
     flag = pairs.flag[e]
-    p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
+    p = with_d_t(params, pairs.d_t[e])
     window = coupling.next_flag(flag, pairs.armed[e], pairs.r_before[e], r, pairs.d_t[e], law.eps, law.at_crossing)
     energy_rule = law.uncouple_rule == coupling.UNCOUPLE_BY_ENERGY
     if energy_rule and (flag == 1 and np.isnan(pairs.coupled_energy[e]) or flag == 0 and window == 1):
@@ -108,7 +108,7 @@ def pair_push(e, d, r, pairs, law, params, n_axes):
             norm2 += d[a] * d[a]
         push = min(1.0, params.c_max / np.sqrt(norm2)) if norm2 > 0.0 else 0.0
     else:
-        p = FunctionParams(params.k_p, params.reach, pairs.d_t[e], params.c_max)
+        p = with_d_t(params, pairs.d_t[e])
         push = pair_control(law.function, r, pairs.flag[e], p) / r if r > 0.0 else 0.0
     for a in range(n_axes):
         d[a] *= push

@@ -219,8 +219,6 @@ class Gas(NamedTuple):
         Centre and radius of each circle (sphere in 3-D).
     wall_reach : float
         ``R + R_w`` (m): a wall or obstacle pushes an agent whose ``P*`` is closer to it than that.
-    k_p : float
-        ``K_P``: a wall's or obstacle's repulsion (8) is the law's, with ``R + R_w`` for its reach.
     c_max : float
         The scenario's tilt limit (rad).
     first : ndarray, shape (1,), bool
@@ -257,7 +255,6 @@ class Gas(NamedTuple):
     walls: np.ndarray
     obstacles: np.ndarray
     wall_reach: float
-    k_p: float
     c_max: float
     first: np.ndarray
     work: np.ndarray

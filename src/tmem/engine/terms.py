@@ -25,30 +25,30 @@ from tmem.engine.variants import Variant, bound, chain
 
 
 @numba.njit(inline="always")
-def _no_agent_terms(k, known, agents, box, terms, gas, n_blocks, counting):
+def _no_agent_terms(k, known, agents, params, box, terms, gas, n_blocks, counting):
     """A variant without agent terms or gas: nothing."""
 
 
 @numba.njit(inline="always")
-def _no_gas(i, known, agents, gas, box, counting, first):
+def _no_gas(i, known, agents, params, gas, box, counting, first):
     """A variant whose gas is not observed: no walls, obstacles or thermostat."""
 
 
-def _agent_block_source(begin, end, k, known, agents, box, terms, gas, counting, first):
+def _agent_block_source(begin, end, k, known, agents, params, box, terms, gas, counting, first):
     """Agents ``begin:end``, one after the other: each flying agent's terms, then its gas."""
     for i in range(begin, end):
         if agents.active[i]:
             term_pushes(i, k, known, agents, box, terms)  # noqa: F821  (bound)
-            gas_part(i, known, agents, gas, box, counting, first)  # noqa: F821  (bound)
+            gas_part(i, known, agents, params, gas, box, counting, first)  # noqa: F821  (bound)
 
 
-def _agent_stage_source(k, known, agents, box, terms, gas, n_blocks, counting):
+def _agent_stage_source(k, known, agents, params, box, terms, gas, n_blocks, counting):
     """Every flying agent's terms and gas, by blocks of agents on threads (module text)."""
     first = first_count(gas, counting)  # noqa: F821  (bound)
     n_agents = known.shape[0]
     per_block = (n_agents + n_blocks - 1) // n_blocks
     for b in numba.prange(n_blocks):
-        agent_block(b * per_block, min(n_agents, (b + 1) * per_block), k, known, agents, box, terms, gas,  # noqa: F821
+        agent_block(b * per_block, min(n_agents, (b + 1) * per_block), k, known, agents, params, box, terms, gas,  # noqa: F821
                     counting, first)  # fmt: skip
 
 

@@ -6,3 +6,7 @@
 * :mod:`tmem.figures.animate` — a run as a video (``tmem animate``);
 * :mod:`tmem.figures.viewer` — a run as one HTML page that plays it in a browser (``tmem view``).
 """
+
+from tmem._lazy import submodules
+
+__getattr__ = submodules(__name__)

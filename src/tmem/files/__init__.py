@@ -6,3 +6,7 @@
 * :mod:`tmem.files.outputs` — writing outputs: atomically, never over a user's files, cleaned up when interrupted;
 * :mod:`tmem.files.exchange` — a run as MCAP (Foxglove) or Crazyswarm2 CSV files.
 """
+
+from tmem._lazy import submodules
+
+__getattr__ = submodules(__name__)

@@ -8,3 +8,7 @@
 * :mod:`tmem.law.synchronise` — speed synchronisation of coupled pairs (S1)-(S3);
 * :mod:`tmem.law.record` — the law of a scenario as the step loop's record.
 """
+
+from tmem._lazy import submodules
+
+__getattr__ = submodules(__name__)

@@ -192,14 +192,7 @@ def corrected_position(x, i, a, gains, row):
         Each agent's ``K``, or one row that every agent shares.
     row : int
         The row of ``gains`` to use (:func:`gains_row`).
-
-    Four components, a tilting multirotor's, are summed written out: the paper's batch of
-    encounters (:mod:`tmem.batch.relative`) is compiled with fused multiply-adds, and the sum
-    written out fuses there as it always has, so its results keep their bits.
     """
-    if gains.shape[1] == 4:
-        return (x[i, a, 0] * gains[row, 0] + x[i, a, 1] * gains[row, 1] + x[i, a, 2] * gains[row, 2]
-                + x[i, a, 3] * gains[row, 3]) / gains[row, 0]  # fmt: skip
     total = x[i, a, 0] * gains[row, 0]
     for m in range(1, gains.shape[1]):
         total += x[i, a, m] * gains[row, m]

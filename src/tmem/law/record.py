@@ -67,6 +67,11 @@ class Law(NamedTuple):
     sync_gain: float
 
 
+#: The fields of :class:`Law` taken as they are from :class:`~tmem.law.params.LawParams` (the others are
+#: derived from it: codes for names, flags for choices).
+_COPIED = tuple(name for name in Law._fields if name in LawParams.model_fields and name != "function")
+
+
 def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gains: np.ndarray) -> tuple[Law, FunctionParams]:
     """The TMEM controller of a scenario with the modal gains ``gains``, and its functions' parameters.
 
@@ -116,10 +121,10 @@ def law_record(params: LawParams, gains: np.ndarray, fallback_steps: int, sync_g
         neighbour_function=code("repulsion") if couples else code(params.function),
         couples=couples,
         at_crossing=params.switch_at == "crossing",
-        eps=params.eps,
         uncouple_rule=coupling.UNCOUPLE_RULES.index(params.uncouple_when),
-        energy_tolerance=params.energy_tolerance,
         fallback_steps=fallback_steps,
         sync_gain=sync_gain,
+        **{name: getattr(params, name) for name in _COPIED},  # numbers of the law, as named there
     )
-    return law, FunctionParams(k_p=float(gains[0]), reach=params.reach, d_t=params.d_t, c_max=params.c_max)
+    kernels = {name: getattr(params, name) for name in FunctionParams._fields if name != "k_p"}  # reach, d_t, c_max ...
+    return law, FunctionParams(k_p=float(gains[0]), **kernels)

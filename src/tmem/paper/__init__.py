@@ -4,3 +4,7 @@
 * :mod:`tmem.paper.further` — Figs. 7 and 9 rerun under the paper's further work (energy-matched
   uncoupling, speed synchronisation).
 """
+
+from tmem._lazy import submodules
+
+__getattr__ = submodules(__name__)

@@ -20,33 +20,65 @@ message naming the field and the reason.  Defaults are documented in
 * :mod:`~tmem.scenario.files` — reading, writing and editing files; the presets.
 """
 
-from tmem.scenario.agents_table import Agent, SwarmParams, Vector
-from tmem.scenario.budget import MAX_RECORD_BYTES
-from tmem.scenario.commands_table import Command
-from tmem.scenario.files import PRESETS, describe, from_dict, load, loads, preset, read_text, with_changes
-from tmem.scenario.formation_table import FormationParams
-from tmem.scenario.schema import MAX_AGENTS_ALL_PAIRS, TRACK_ALL_PAIRS, Scenario
-from tmem.scenario.sensing_table import SensingParams
-from tmem.scenario.space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
-from tmem.scenario.tables import (
-    LIMIT,
-    MODEL_KINDS,
-    ControllerParams,
-    FieldError,
-    InteractionParams,
-    LinearModelParams,
-    ModelParams,
-    NeighborParams,
-    NonNegative,
-    Number,
-    Pair,
-    Positive,
-    QuadrotorModelParams,
-    ScenarioError,
-    SimulationParams,
-    StrictModel,
-)
-from tmem.scenario.wind_table import TurbulenceParams, WindParams
+from tmem._lazy import submodules
+
+#: Each public name and the module of this package that defines it, imported on first use (PEP 562),
+#: so that a module of its tables (``tmem.scenario.fields``) imports without the whole schema.
+_EXPORTS = {
+    "Agent": "agents_table",
+    "Command": "commands_table",
+    "ControllerParams": "tables",
+    "CoverageParams": "space_table",
+    "FieldError": "tables",
+    "FormationParams": "formation_table",
+    "InteractionParams": "tables",
+    "LIMIT": "tables",
+    "LinearModelParams": "tables",
+    "MAX_AGENTS_ALL_PAIRS": "schema",
+    "MAX_RECORD_BYTES": "budget",
+    "MODEL_KINDS": "tables",
+    "ModelParams": "tables",
+    "NeighborParams": "tables",
+    "NonNegative": "tables",
+    "Number": "tables",
+    "Obstacle": "space_table",
+    "PRESETS": "files",
+    "Pair": "tables",
+    "Positive": "tables",
+    "QuadrotorModelParams": "tables",
+    "Scenario": "schema",
+    "ScenarioError": "tables",
+    "SensingParams": "sensing_table",
+    "SimulationParams": "tables",
+    "SpaceParams": "space_table",
+    "StrictModel": "tables",
+    "SwarmParams": "agents_table",
+    "TRACK_ALL_PAIRS": "schema",
+    "ThermostatParams": "space_table",
+    "TurbulenceParams": "wind_table",
+    "Vector": "agents_table",
+    "WindParams": "wind_table",
+    "describe": "files",
+    "from_dict": "files",
+    "load": "files",
+    "loads": "files",
+    "preset": "files",
+    "read_text": "files",
+    "with_changes": "files",
+}
+
+
+def __getattr__(name: str) -> object:
+    """A public name from its module, or a module of this package, imported on first use."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        return _submodule(name)
+    from importlib import import_module
+
+    return getattr(import_module(f"tmem.scenario.{module}"), name)
+
+
+_submodule = submodules(__name__)
 
 __all__ = [
     "LIMIT",

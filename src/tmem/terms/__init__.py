@@ -12,6 +12,8 @@ modules here import no compiler: a term's kernel is compiled when a run binds it
 
 from __future__ import annotations
 
+from tmem._lazy import submodules
+
 from functools import cache
 from importlib import import_module
 
@@ -32,3 +34,5 @@ def term_class(name: str):
     """
     module, cls = TERMS[name].split(":")
     return getattr(import_module(module), cls)
+
+__getattr__ = submodules(__name__)  # noqa: F811  (submodules loaded on first use)

@@ -16,6 +16,8 @@ compiled code.  Adding a model is one module in this package and one row here
 
 from __future__ import annotations
 
+from tmem._lazy import submodules
+
 from functools import cache
 from importlib import import_module
 from typing import Any
@@ -72,3 +74,5 @@ def vehicle_model(params: Any, wind: Any = None):
     """
     model_class = vehicle_class(params.kind)
     return model_class(params) if wind is None else model_class(params, wind)
+
+__getattr__ = submodules(__name__)  # noqa: F811  (submodules loaded on first use)

@@ -8,3 +8,7 @@
 * :mod:`tmem.world.sensing` — what each agent knows of itself and its neighbours (noise, delay, loss,
   range); :mod:`tmem.world.streams`, the counter-based random draws it takes.
 """
+
+from tmem._lazy import submodules
+
+__getattr__ = submodules(__name__)

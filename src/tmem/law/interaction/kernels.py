@@ -27,9 +27,10 @@ The paper writes the saturation as ``max(s_d C_max, .)``; it is read here as
 ``|U| <= c_max`` with the sign set by the function.  ``K_P`` is the modal gain
 on position (the paper's ``K1``).
 
-:func:`pair_control` dispatches on a function's integer code; it is written
-from the registry when this module is imported, one branch per row, and the
-step loop, the batch and :func:`evaluate` call it.  The kernels and the
+:func:`pair_control` dispatches on a function's integer code; it is composed
+from the registry when this module is imported, one branch per row (each a
+compiled closure over its row's kernel), and the step loop, the batch and
+:func:`evaluate` call it.  The kernels and the
 dispatch are inlined by Numba itself (``inline="always"``): a function loaded
 from Numba's on-disk cache cannot be inlined by the compiler, and a call left
 inside the loop of neighbour pushes would keep that loop from being vectorised
@@ -66,6 +67,40 @@ class FunctionParams(NamedTuple):
     reach: float
     d_t: float
     c_max: float
+
+
+#: Where ``d_t`` and ``reach`` sit in :class:`FunctionParams`, and the fields after them (slices of a
+#: record in compiled code need bounds known before it is typed).
+_D_T, _REACH = FunctionParams._fields.index("d_t"), FunctionParams._fields.index("reach")
+_AFTER_D_T, _AFTER_REACH = _D_T + 1, _REACH + 1
+
+
+@numba.njit(cache=True, inline="always")
+def with_d_t(p, d_t):
+    """``p`` with the set distance ``d_t`` (a formation pair's own), every other field as it is.
+
+    Parameters
+    ----------
+    p : FunctionParams
+        The interaction functions' parameters.
+    d_t : float
+        The set distance (m).
+    """
+    return FunctionParams(*(p[:_D_T] + (d_t,) + p[_AFTER_D_T:]))
+
+
+@numba.njit(cache=True, inline="always")
+def with_reach(p, reach):
+    """``p`` with the reach ``reach`` (a wall's ``R + R_w``), every other field as it is.
+
+    Parameters
+    ----------
+    p : FunctionParams
+        The interaction functions' parameters.
+    reach : float
+        The reach (m).
+    """
+    return FunctionParams(*(p[:_REACH] + (reach,) + p[_AFTER_REACH:]))
 
 
 @numba.njit(cache=True, inline="always")
@@ -155,31 +190,29 @@ def improved_switching(r, f_en, p):
     return _saturate(u, p.c_max)
 
 
-def _dispatch_source() -> str:
-    """Source of :func:`pair_control`: one branch per registry row, the last one the fallback."""
-    lines = ["def pair_control(function, r, f_en, p):"]
-    for row in FUNCTIONS[:-1]:
-        lines += [f"    if function == {code(row.name)}:", f"        return {row.kernel}(r, f_en, p)"]
-    lines.append(f"    return {FUNCTIONS[-1].kernel}(r, f_en, p)")
-    return "\n".join(lines) + "\n"
+def _dispatch(rows) -> object:
+    """:func:`pair_control` over the registry's ``rows``: the first row's kernel where ``function`` is
+    its code, else the dispatch over the rest (the last row's kernel where no code matched)."""
+    kernel, number = globals()[rows[0].kernel], code(rows[0].name)
+    if len(rows) == 1:
+        @numba.njit(inline="always")
+        def last(function, r, f_en, p):
+            return kernel(r, f_en, p)
 
+        return last
+    rest = _dispatch(rows[1:])
 
-def _compile_dispatch():
-    namespace = {row.kernel: globals()[row.kernel] for row in FUNCTIONS}
-    exec(compile(_dispatch_source(), f"<{__name__}: pair_control from the registry>", "exec"), namespace)
-    dispatch = numba.njit(inline="always")(namespace["pair_control"])
-    dispatch.__doc__ = (
-        "``U`` of the function with integer code ``function`` (its registry row) for one pair: "
-        "``kernel(r, f_en, p)``, ``r = |d|``.\n\n"
-        "Parameters\n----------\n"
-        "function : int\n    The registry code (:func:`tmem.law.interaction.registry.code`).\n"
-        "r, f_en, p\n    As the kernels take them: ``|d|`` (m), ``F_en``, :class:`FunctionParams`.\n"
-    )
+    @numba.njit(inline="always")
+    def dispatch(function, r, f_en, p):
+        if function == number:
+            return kernel(r, f_en, p)
+        return rest(function, r, f_en, p)
+
     return dispatch
 
 
 #: ``pair_control(function, r, f_en, p)``: the kernel of the function with code ``function``.
-pair_control = _compile_dispatch()
+pair_control = _dispatch(FUNCTIONS)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -234,6 +267,6 @@ def evaluate(function: str, d, f_en=0, *, k_p: float, reach: float, d_t: float, 
     """
     d, flags = np.broadcast_arrays(np.asarray(d, dtype=float), np.asarray(f_en, dtype=np.int64))
     out = np.empty(d.shape)
-    params = FunctionParams(float(k_p), float(reach), float(d_t), float(c_max))
+    params = FunctionParams(k_p=float(k_p), reach=float(reach), d_t=float(d_t), c_max=float(c_max))
     _evaluate(code(function), np.ascontiguousarray(d).ravel(), np.ascontiguousarray(flags).ravel(), params, out.reshape(-1))
     return out
