@@ -231,9 +231,9 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     signum = SIGNALS[name]
     run = tmp_path / "run"
     shutil.copytree(run_2d, run)
-    gif = run / "animation.gif"
+    gif = tmp_path / "run.gif"  # beside the run, by default
     command = Command("animate", run, "--max-frames", "40", cwd=tmp_path)
-    reached = moment(command, when, lambda: bool(partials(run, "animation.gif")) or gif.exists())
+    reached = moment(command, when, lambda: bool(partials(tmp_path, "run.gif")) or gif.exists())
     if reached:
         command.send(signum)
     code, output = command.finish()
@@ -242,11 +242,11 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     # The signal may come as the finished file is being renamed into place: then it is whole.
     assert not gif.exists() or gif.read_bytes().endswith(b";"), "a partial GIF"  # ";": a GIF's trailer
     if signum != signal.SIGKILL:
-        assert partials(run, "animation.gif") == []
+        assert partials(tmp_path, "run.gif") == []
         return
     result = CliRunner().invoke(app, ["animate", str(run), "--max-frames", "3"])
     assert result.exit_code == 0, result.output
-    assert gif.exists() and partials(run, "animation.gif") == []
+    assert gif.exists() and partials(tmp_path, "run.gif") == []
 
 
 # --- tmem plot
