@@ -347,6 +347,19 @@ def test_sweep_removes_temporary_results_of_a_killed_finish(tmp_path, threads):
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [MANIFEST]
 
 
+def test_a_sweep_keeps_a_report_the_user_changed(tmp_path, threads):
+    sweep = loads_sweep(SWEEP, source="s.toml")
+    out = tmp_path / "out"
+    run_sweep(sweep, out, scheduler=threads)
+    assert run_sweep(sweep, out, scheduler=threads).ran == 0  # its own report, as written: replaced
+    with open(out / "summary.md", "a") as f:
+        f.write("my conclusions\n")
+    before = snapshot(out)
+    with pytest.raises(OutputError, match=r"whose files were changed since it wrote them \(summary.md\)"):
+        run_sweep(sweep, out, scheduler=threads)
+    assert snapshot(out) == before
+
+
 # --- Item 4: a sweep killed between writing sweep.toml and sweep.json
 
 

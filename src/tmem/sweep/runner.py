@@ -36,7 +36,7 @@ from pathlib import Path
 import pandas as pd
 
 import tmem.engine  # noqa: F401 - before tmem.law.record (through the tasks), which the engine's driver imports back
-from tmem.files.outputs import lock_beside
+from tmem.files.outputs import lock_beside, update_files
 from tmem.sweep.cluster import check_workers, dask_client, takes_signals
 from tmem.sweep.report import write_report
 from tmem.sweep.spec import Sweep
@@ -164,7 +164,8 @@ def run_sweep(
         if not store.exists:  # a sweep of no cases
             held.enter_context(store.opened())
         table = store.finish()
-        write_report(table, sweep, out)
+        with update_files(out) as folder:  # the report replaces an earlier one only while it is as tmem wrote it
+            write_report(table, sweep, folder)
     return SweepOutcome(table=table, ran=ran, failed=int(table["error"].notna().sum()), seconds=time.perf_counter() - started)
 
 

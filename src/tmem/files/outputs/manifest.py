@@ -228,10 +228,11 @@ def _check_directory(out: Path, command: str, adopt: Callable[[Path], bool] | No
             return out
         if manifest is None or manifest.command != command:
             raise _refuse(out, f"holds {describe(out)}; choose another --out or remove it")
-        if manifest.files is None:
-            return out
-        others = sorted(f for f in _files_below(out) if f not in manifest.files)
-        edited = [] if others else changed_files(out, manifest, manifest.files)
+        if manifest.files is None:  # a sweep's: what it will replace (its report) must still be as written
+            others, edited = [], changed_files(out, manifest, list(manifest.digests or ()))
+        else:
+            others = sorted(f for f in _files_below(out) if f not in manifest.files)
+            edited = [] if others else changed_files(out, manifest, manifest.files)
     except OSError as exc:
         raise _refuse(out, f"cannot be read ({exc.strerror or exc})") from None
     for found, what in ((others, "and files it did not write"), (edited, "whose files were changed since it wrote them")):

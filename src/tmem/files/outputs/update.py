@@ -1,4 +1,5 @@
-"""Files written again into an existing output, all at once: the figures ``tmem plot`` draws into a run.
+"""Files written again into an existing output, all at once: the figures ``tmem plot`` draws into a run,
+the report a sweep writes when its last case is in.
 
 The files are written into a hidden temporary folder inside the directory (held by its writer's
 lock); when all are complete, they replace their namesakes together (Ctrl-C and SIGTERM held back
@@ -9,7 +10,10 @@ figure's name, or a figure the user changed, is never replaced: the update is re
 before anything is replaced.  Nothing else in the directory is touched.
 
 The manifest is the directory's own (a ``tmem run`` output) or, for a run inside a ``tmem paper``
-output, its parent's, which lists the run's files under the run's folder name.  A manifest of an
+output, its parent's, which lists the run's files under the run's folder name.  A sweep's
+manifest lists no files (its directory grows); the files of its report are tmem's when its digests
+name them.  A sweep directory of an earlier tmem keeps no digests: its report's files are replaced
+by name, as before.  A manifest of an
 earlier tmem, without digests, is written again with the digests of the files it lists that are
 still as tmem wrote them; a file it lists that was changed is no longer listed (it is the user's).
 """
@@ -44,15 +48,18 @@ def _manifest_of(directory: Path) -> tuple[Path, str, Manifest] | None:
 def _check_namesakes(directory: Path, names: list[str], found: tuple[Path, str, Manifest] | None) -> None:
     """Refuse a namesake in ``directory`` that tmem did not write (not in the manifest), that was changed
     since, or that is not a file."""
-    listed = found[2].files if found is not None and found[2].files is not None else frozenset()
+    manifest = found[2] if found is not None else None
     prefix = found[1] if found is not None else ""
+    grows = manifest is not None and manifest.files is None  # a sweep's: its report's files are in its digests
+    ours = (manifest.files if not grows else manifest.digests) if manifest is not None else frozenset()
     for name in names:
         target = directory / name
         if target.is_symlink() or (target.exists() and not target.is_file()):
             raise OutputError(f"{target}: is not a file; move it out first")
-        if target.exists() and prefix + name not in listed:
+        if target.exists() and ours is not None and prefix + name not in ours:
             raise OutputError(f"{target}: exists and was not written by tmem; move it out first")
-    edited = changed_files(directory, found[2], names, prefix) if found is not None else []
+    judged = manifest is not None and not (grows and manifest.digests is None)  # an earlier tmem's sweep: by name
+    edited = changed_files(directory, manifest, names, prefix) if judged else []
     if edited:
         raise OutputError(f"{directory / edited[0]}: was changed since tmem wrote it; move it out first")
 
@@ -60,15 +67,17 @@ def _check_namesakes(directory: Path, names: list[str], found: tuple[Path, str, 
 def _listing(found: tuple[Path, str, Manifest], added: dict[str, str]) -> str:
     """The manifest's text with the files ``added`` (name -> digest, relative to the manifest's directory)."""
     folder, _, manifest = found
-    files = set(manifest.files or ()) | set(added)
+    if manifest.files is None:  # a directory that grows (a sweep's): no list, the digests of what may be replaced
+        return manifest_text(manifest.command, None, {**(manifest.digests or {}), **added})
+    files = set(manifest.files) | set(added)
     digests = dict(manifest.digests or {})
     if manifest.digests is None:  # an earlier tmem's: keep what is still tmem's, with its digest from now on
-        kept = [name for name in manifest.files or () if name not in added]
+        kept = [name for name in manifest.files if name not in added]
         edited = set(changed_files(folder, manifest, kept))
         files -= edited
         digests = record(folder, [name for name in kept if name not in edited])
     digests.update(added)
-    return manifest_text(manifest.command, sorted(files) if manifest.files is not None else None, digests)
+    return manifest_text(manifest.command, sorted(files), digests)
 
 
 @contextmanager
@@ -99,7 +108,7 @@ def update_files(directory: str | Path) -> Iterator[Path]:
         _check_namesakes(directory, names, found)
         prefix = found[1] if found is not None else ""
         added = {prefix + name: digest for name, digest in record(tmp, names).items()}
-        text = _listing(found, added) if found is not None and found[2].files is not None else None
+        text = _listing(found, added) if found is not None else None
         with _signals_held():
             for name in names:
                 os.replace(tmp / name, directory / name)
