@@ -163,9 +163,16 @@ def is_leftover(path: Path) -> bool:
     """
     if not is_partial(path):
         return False
-    try:
-        fd = os.open(path / WRITING, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError:  # no lock file (an earlier tmem's, a file), or not ours to open: not known to be dead
+    fd = -1
+    for mode in (os.O_RDWR, os.O_RDONLY):  # writable where it can be: NFS locks a file only so
+        try:
+            fd = os.open(path / WRITING, mode | os.O_NOFOLLOW | os.O_NONBLOCK)
+            break
+        except PermissionError:
+            continue
+        except OSError:  # no lock file (an earlier tmem's, a file): not known to be dead
+            return False
+    if fd < 0:
         return False
     try:
         return _lock(fd, block=False)
