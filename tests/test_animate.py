@@ -69,7 +69,7 @@ def _frames(path):
 def test_gif_has_one_frame_per_time_up_to_max_frames(tmp_path, max_frames, expected):
     run = _write(tmp_path)
     out = animate(run, max_frames=max_frames, dpi=40)
-    assert out == run / "animation.gif"
+    assert out == run.parent / f"{run.name}.gif"  # beside the run directory, never in it
     frames = _frames(out)
     assert len(frames) == expected
     assert ImageChops.difference(frames[0], frames[-1]).getbbox() is not None
@@ -121,7 +121,7 @@ def test_the_paper_s_run_can_be_animated_from_the_command_line(tmp_path):
     write_run(tmem.simulate(scenario), tmp_path / "fig9")
     result = CliRunner().invoke(app, ["animate", str(tmp_path / "fig9"), "--max-frames", "8"])
     assert result.exit_code == 0, result.output
-    assert len(_frames(tmp_path / "fig9" / "animation.gif")) == 8
+    assert len(_frames(tmp_path / "fig9.gif")) == 8  # beside the run, as every derived file
 
 
 def test_3d_run_is_drawn_in_3d_beside_its_projection(tmp_path):
@@ -190,7 +190,7 @@ def test_damaged_trajectory_is_refused_naming_the_file(tmp_path, damage):
         animate(tmp_path, max_frames=3)
     message = str(error.value)
     assert message.startswith(f"animate: {path}: cannot be read as a run's trajectory (") and "\n" not in message
-    assert not (tmp_path / "animation.gif").exists()
+    assert not (tmp_path.parent / f"{tmp_path.name}.gif").exists()
 
 
 def test_damaged_trajectory_gives_one_line_and_exit_2_from_the_command(tmp_path):

@@ -245,7 +245,7 @@ def test_unwritable_output_gives_one_line_and_leaves_nothing(tmp_path, runner, m
     def full(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("tmem.files.outputs.replace._new_partial_directory", full)
+    monkeypatch.setattr("tmem.files.outputs.replace.make_partial", full)
     out = tmp_path / "new" / "deeper" / "out"
     result = runner.invoke(app, ["run", str(_ok_scenario(tmp_path)), "--out", str(out)])
     assert result.exit_code == 2 and "No space left" in result.stderr

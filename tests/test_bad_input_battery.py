@@ -13,7 +13,9 @@ no traceback, and nothing written under ``--out``.  The cases are generated syst
   the file, swarms and formations too big for memory, long or unprintable names;
 * sweep files (``[random]`` choices of mixed kinds, bad ranges, bad keys) and ``animate`` arguments.
 
-``tests/test_bad_input.py`` keeps its own cases; those are left out here.
+``tests/test_bad_input.py`` keeps its own cases; those are left out here.  The battery goes on in
+``tests/test_bad_output_battery.py``: outputs that are not regular files, usage errors, names with
+control characters.
 """
 
 from __future__ import annotations

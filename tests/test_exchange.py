@@ -264,14 +264,14 @@ def _tmem(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "tmem", *args], capture_output=True, text=True, timeout=300, cwd=cwd)
 
 
-def test_the_command_writes_inside_the_run_by_default_and_replaces_its_own(triangle, tmp_path):
+def test_the_command_writes_beside_the_run_by_default_and_replaces_its_own(triangle, tmp_path):
     import shutil
 
     run_dir = tmp_path / "run"
     shutil.copytree(triangle[0], run_dir)
-    for to, name in (("mcap", "trajectory.mcap"), ("csv", "crazyswarm")):
+    for to, name in (("mcap", "run.mcap"), ("csv", "run-crazyswarm")):
         result = CliRunner().invoke(app, ["export", str(run_dir), "--to", to])
-        assert result.exit_code == 0 and f"written {run_dir / name}" in result.output, result.output
+        assert result.exit_code == 0 and f"written {tmp_path / name}" in result.output, result.output
         again = CliRunner().invoke(app, ["export", str(run_dir), "--to", to])
         assert again.exit_code == 0, again.output
 

@@ -231,9 +231,9 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     signum = SIGNALS[name]
     run = tmp_path / "run"
     shutil.copytree(run_2d, run)
-    gif = run / "animation.gif"
+    gif = tmp_path / "run.gif"  # beside the run, by default
     command = Command("animate", run, "--max-frames", "40", cwd=tmp_path)
-    reached = moment(command, when, lambda: bool(partials(run, "animation.gif")) or gif.exists())
+    reached = moment(command, when, lambda: bool(partials(tmp_path, "run.gif")) or gif.exists())
     if reached:
         command.send(signum)
     code, output = command.finish()
@@ -242,11 +242,11 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     # The signal may come as the finished file is being renamed into place: then it is whole.
     assert not gif.exists() or gif.read_bytes().endswith(b";"), "a partial GIF"  # ";": a GIF's trailer
     if signum != signal.SIGKILL:
-        assert partials(run, "animation.gif") == []
+        assert partials(tmp_path, "run.gif") == []
         return
     result = CliRunner().invoke(app, ["animate", str(run), "--max-frames", "3"])
     assert result.exit_code == 0, result.output
-    assert gif.exists() and partials(run, "animation.gif") == []
+    assert gif.exists() and partials(tmp_path, "run.gif") == []
 
 
 # --- tmem plot
@@ -262,8 +262,7 @@ def test_interrupted_plot_leaves_the_old_figures_or_whole_new_ones(run_2d, tmp_p
     run = tmp_path / "run"
     shutil.copytree(run_2d, run)
     figures = sorted(p.name for p in run.glob("*.png"))
-    for figure in figures:
-        (run / figure).write_bytes(b"old")
+    before = {figure: (run / figure).read_bytes() for figure in figures}  # tmem's own: plot may replace them
     command = Command("plot", run, cwd=tmp_path)
     reached = moment(command, "writing", lambda: bool(partials(run, "figures")))
     if reached:
@@ -272,11 +271,11 @@ def test_interrupted_plot_leaves_the_old_figures_or_whole_new_ones(run_2d, tmp_p
     assert reached, f"plot ended before it wrote: {output}"
     check_exit(code, output, signum, "writing")
     after = [(run / figure).read_bytes() for figure in figures]
-    if signum != signal.SIGKILL:  # all at once: the renames are not interrupted
-        assert all(a == b"old" for a in after) or all(whole_png(a) for a in after), output
+    # The same run draws the same bytes: old or new, each figure is whole and as tmem drew it.
+    assert all(whole_png(a) and a == before[f] for f, a in zip(figures, after)), output
+    if signum != signal.SIGKILL:
         assert partials(run, "figures") == []
         return
-    assert all(a == b"old" or whole_png(a) for a in after)
     result = CliRunner().invoke(app, ["plot", str(run)])
     assert result.exit_code == 0, result.output
     assert partials(run, "figures") == [] and all(whole_png((run / f).read_bytes()) for f in figures)

@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -16,6 +17,7 @@ from typer.testing import CliRunner
 
 from tmem.cli.main import app
 from tmem.files.outputs import MANIFEST, OutputError, lock, partial_name
+from tmem.files.outputs.names import WRITING
 from tmem.sweep import loads_sweep, run_sweep
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
@@ -94,20 +96,102 @@ def test_run_refuses_a_paper_output_and_says_what_is_there(runner, tmp_path):
     assert snapshot(paper) == before
 
 
-def test_rerunning_run_keeps_the_animation_written_into_its_directory(runner, tmp_path, pair_2d):
+def test_rerunning_run_keeps_an_animation_written_into_its_directory(runner, tmp_path, pair_2d):
     out = tmp_path / "pair"
     assert invoke(runner, "run", pair_2d, "--out", out)[0] == 0
-    code, stderr, _ = invoke(runner, "animate", out, "--max-frames", "5")
+    code, stderr, _ = invoke(runner, "animate", out, "--max-frames", "5", "--out", out / "animation.gif")
     assert code == 0, stderr
     before = snapshot(out)
     code, stderr, _ = invoke(runner, "run", pair_2d, "--out", out)
     one_line_refusal(code, stderr)
     assert "holds a `tmem run` output and files it did not write (animation.gif)" in stderr
     assert snapshot(out) == before
-    # animate, run again, replaces its own animation
-    code, stderr, _ = invoke(runner, "animate", out, "--max-frames", "4")
+
+
+def test_derived_files_go_beside_the_run_and_the_run_can_be_written_again(runner, tmp_path, pair_2d):
+    """`tmem view`, `tmem animate` and `tmem export` by default: beside the run directory, never in it."""
+    out = tmp_path / "pair"
+    assert invoke(runner, "run", pair_2d, "--out", out)[0] == 0
+    run_files = sorted(p.name for p in out.iterdir())
+    for args in (("animate", out, "--max-frames", "3"), ("export", out, "--to", "mcap"), ("export", out, "--to", "csv"),
+                 ("view", out)):  # fmt: skip
+        code, stderr, _ = invoke(runner, *args)
+        assert code == 0, stderr
+    assert sorted(p.name for p in out.iterdir()) == run_files
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pair", "pair-crazyswarm", "pair.gif", "pair.html", "pair.mcap"]
+    code, stderr, _ = invoke(runner, "run", pair_2d, "--out", out)
     assert code == 0, stderr
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["pair"]
+    for args in (("animate", out, "--max-frames", "4"), ("export", out, "--to", "csv")):  # their own, replaced
+        code, stderr, _ = invoke(runner, *args)
+        assert code == 0, stderr
+
+
+#: A command that writes an output directory, the file of it a user edits, and the command again.
+EDITED = {
+    "run": (lambda run, out: ("run", run["scenario"], "--out", out), "summary.json"),
+    "plot --out": (lambda run, out: ("plot", run["out"], "--out", out), "velocity.png"),
+    "export --to csv": (lambda run, out: ("export", run["out"], "--to", "csv", "--out", out), "agent1.csv"),
+}
+
+
+@pytest.fixture(scope="module")
+def written_run(pair_2d, tmp_path_factory):
+    out = tmp_path_factory.mktemp("written") / "pair"
+    assert invoke(CliRunner(), "run", pair_2d, "--out", out)[0] == 0
+    return {"scenario": pair_2d, "out": out}
+
+
+@pytest.mark.parametrize("command", EDITED)
+def test_a_file_changed_since_tmem_wrote_it_is_never_replaced(runner, tmp_path, written_run, command):
+    args, name = EDITED[command]
+    out = tmp_path / "out"
+    assert invoke(runner, *args(written_run, out))[0] == 0
+    with open(out / name, "ab") as f:
+        f.write(b"\nmy notes")
+    before = snapshot(out)
+    code, stderr, _ = invoke(runner, *args(written_run, out))
+    one_line_refusal(code, stderr)
+    assert f"whose files were changed since it wrote them ({name})" in stderr
+    assert snapshot(out) == before
+    (out / name).unlink()  # once it is gone, nothing of the user's is lost: the output is written again
+    assert invoke(runner, *args(written_run, out))[0] == 0
+
+
+def test_plot_keeps_a_figure_the_user_marked(runner, tmp_path, written_run):
+    run = tmp_path / "pair"
+    shutil.copytree(written_run["out"], run)
+    with open(run / "velocity.png", "ab") as f:
+        f.write(b"annotated")
+    before = snapshot(run)
+    code, stderr, _ = invoke(runner, "plot", run)
+    one_line_refusal(code, stderr)
+    assert f"{run / 'velocity.png'}: was changed since tmem wrote it" in stderr
+    assert snapshot(run) == before
+
+
+def legacy(out: Path) -> None:
+    """Make ``out``'s manifest one of an earlier tmem: no digests."""
+    manifest = json.loads((out / MANIFEST).read_text())
+    del manifest["sha256"]
+    (out / MANIFEST).write_text(json.dumps(manifest))
+
+
+def test_an_earlier_tmems_output_is_replaced_only_while_no_file_is_newer_than_its_manifest(runner, tmp_path, written_run):
+    out = tmp_path / "pair"
+    shutil.copytree(written_run["out"], out)
+    legacy(out)
+    assert invoke(runner, "run", written_run["scenario"], "--out", out)[0] == 0
+    assert "sha256" in json.loads((out / MANIFEST).read_text())  # written again, with digests
+    legacy(out)
+    time.sleep(0.01)
+    (out / "summary.json").write_text((out / "summary.json").read_text() + "\n")  # changed after the manifest
+    code, stderr, _ = invoke(runner, "run", written_run["scenario"], "--out", out)
+    one_line_refusal(code, stderr)
+    assert "were changed since it wrote them (summary.json)" in stderr
+    code, stderr, _ = invoke(runner, "plot", out)  # the summary is no figure: plot may draw, and lists what is still tmem's
+    assert code == 0, stderr
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert "summary.json" not in manifest["files"] and "velocity.png" in manifest["sha256"]
 
 
 @pytest.mark.parametrize("command", ["run", "paper"])
@@ -177,19 +261,39 @@ def test_animate_replaces_only_a_file_it_wrote(runner, tmp_path, pair_2d):
 # --- Item 4: what a killed process left is removed by the next run; nothing else is
 
 
+def killed_writers_partial(folder: Path, name: str, pid: int | None = None) -> Path:
+    """A temporary directory as a killed tmem leaves it: its lock file there, held by nobody."""
+    path = folder / f".{name}.tmem-partial-{pid or dead_pid()}-0123abcd"
+    path.mkdir()
+    (path / WRITING).write_text(json.dumps({"pid": pid or 1}))
+    (path / name).write_bytes(b"\0" * 1000)
+    return path
+
+
+HOLD_PARTIAL = """
+import fcntl, json, os, sys, time
+path = sys.argv[1]
+os.makedirs(path)
+fd = os.open(os.path.join(path, ".tmem-writing"), os.O_RDWR | os.O_CREAT)
+fcntl.flock(fd, fcntl.LOCK_EX)
+os.write(fd, json.dumps({"pid": int(sys.argv[2]), "host": "elsewhere"}).encode())
+print("held", flush=True)
+time.sleep(120)
+"""
+
+
 def test_run_removes_what_a_killed_run_left_and_nothing_else(runner, tmp_path):
     out = tmp_path / "out"
-    gone = tmp_path / f".out.tmem-partial-{dead_pid()}-0123abcd"
-    gone.mkdir()
-    (gone / "trajectory.nc").write_bytes(b"\0" * 1000)
+    gone = killed_writers_partial(tmp_path, "out")
     kept = [
-        tmp_path / f".out.tmem-partial-{os.getpid()}-0123abcd",  # a process still running (this one)
+        tmp_path / f".out.tmem-partial-{dead_pid()}-0123abce",  # no lock file: an earlier tmem's, or being made
         tmp_path / ".out.tmem-partial-notes",  # not tmem's pattern
         tmp_path / ".out.k2j4h5g6",  # an earlier tmem's name, indistinguishable from a user's
         tmp_path / f"out.tmem-partial-{dead_pid()}-0123abcd",  # not hidden
     ]
     for path in kept:
         path.mkdir()
+    (kept[-1] / WRITING).write_text("")
     code, stderr, _ = invoke(runner, "run", EXAMPLES / "repulsion.toml", "--out", out)
     assert code == 0, stderr
     assert not gone.exists()
@@ -197,14 +301,33 @@ def test_run_removes_what_a_killed_run_left_and_nothing_else(runner, tmp_path):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out.tmem-partial-") and p not in kept]
 
 
+def test_a_writer_in_another_pid_namespace_is_left_to_write(runner, tmp_path):
+    """Its process id means nothing here (a container, `unshare --pid`): its lock says it writes."""
+    foreign = dead_pid()  # no such process in this namespace
+    writing = tmp_path / f".out.tmem-partial-{foreign}-89abcdef"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    holder = subprocess.Popen([sys.executable, "-c", HOLD_PARTIAL, str(writing), str(foreign)], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert holder.stdout.readline() == "held\n"
+        code, stderr, _ = invoke(runner, "run", EXAMPLES / "repulsion.toml", "--out", tmp_path / "out")
+        assert code == 0, stderr
+        assert (writing / WRITING).is_file(), "another writer's work was removed"
+    finally:
+        holder.kill()
+        holder.wait()
+    # its writer gone, the next writer into the folder removes it
+    code, stderr, _ = invoke(runner, "run", EXAMPLES / "repulsion.toml", "--out", tmp_path / "out")
+    assert code == 0, stderr
+    assert not writing.exists()
+
+
 def test_animate_removes_a_killed_animations_partial_file(runner, tmp_path, pair_2d):
     out = tmp_path / "pair"
     assert invoke(runner, "run", pair_2d, "--out", out)[0] == 0
-    partial = out / f".animation.gif.tmem-partial-{dead_pid()}-00ff00ff.gif"
-    partial.write_bytes(b"GIF89a cut short")
+    partial = killed_writers_partial(tmp_path, "pair.gif")
     code, stderr, _ = invoke(runner, "animate", out, "--max-frames", "3")
     assert code == 0, stderr
-    assert not partial.exists() and (out / "animation.gif").exists()
+    assert not partial.exists() and (tmp_path / "pair.gif").exists()
 
 
 def test_sweep_removes_temporary_results_of_a_killed_finish(tmp_path, threads):
@@ -222,6 +345,19 @@ def test_sweep_removes_temporary_results_of_a_killed_finish(tmp_path, threads):
     assert again.ran == 0
     assert not [p for p in leftovers if p.exists()]
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [MANIFEST]
+
+
+def test_a_sweep_keeps_a_report_the_user_changed(tmp_path, threads):
+    sweep = loads_sweep(SWEEP, source="s.toml")
+    out = tmp_path / "out"
+    run_sweep(sweep, out, scheduler=threads)
+    assert run_sweep(sweep, out, scheduler=threads).ran == 0  # its own report, as written: replaced
+    with open(out / "summary.md", "a") as f:
+        f.write("my conclusions\n")
+    before = snapshot(out)
+    with pytest.raises(OutputError, match=r"whose files were changed since it wrote them \(summary.md\)"):
+        run_sweep(sweep, out, scheduler=threads)
+    assert snapshot(out) == before
 
 
 # --- Item 4: a sweep killed between writing sweep.toml and sweep.json
@@ -263,11 +399,24 @@ def test_a_sweep_interrupted_while_making_its_directory_leaves_nothing(tmp_path,
 HOLD_LOCK = """
 import sys, time
 from pathlib import Path
-from tmem.files.outputs import lock
-with lock(Path(sys.argv[1]), "sweep"):
+from tmem.files import outputs
+with getattr(outputs, sys.argv[2])(Path(sys.argv[1]), "sweep"):
     print("held", flush=True)
     time.sleep(60)
 """
+
+
+@contextmanager
+def held(path: Path, how: str = "lock"):
+    """Another process holding the sweep's lock of ``path`` (``how``: ``lock``, inside; ``lock_beside``)."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    holder = subprocess.Popen([sys.executable, "-c", HOLD_LOCK, str(path), how], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert holder.stdout.readline() == "held\n"
+        yield holder
+    finally:
+        holder.send_signal(signal.SIGKILL)
+        holder.wait()
 
 
 def test_a_second_sweep_into_a_directory_in_use_is_refused_until_the_first_is_gone(tmp_path, threads):
@@ -277,20 +426,54 @@ def test_a_second_sweep_into_a_directory_in_use_is_refused_until_the_first_is_go
     sweep = loads_sweep(SWEEP, source=str(sweep_file))
     run_sweep(sweep, out, scheduler=threads)
     (out / "results.parquet").unlink()  # as if unfinished: every case to run again
-    env = {**os.environ, "PYTHONPATH": str(SRC)}
-    holder = subprocess.Popen([sys.executable, "-c", HOLD_LOCK, str(out)], stdout=subprocess.PIPE, text=True, env=env)
-    try:
-        assert holder.stdout.readline() == "held\n"
+    with held(out) as holder:
         code, stderr, _ = invoke(CliRunner(), "sweep", sweep_file, "--out", out, "--scheduler", threads)
         one_line_refusal(code, stderr)
         assert f"another `tmem sweep` (process {holder.pid}) is writing to it" in stderr
         assert not (out / "results.parquet").exists()
-    finally:
-        holder.send_signal(signal.SIGKILL)
-        holder.wait()
     # the holder was killed: its lock went with it
     assert run_sweep(sweep, out, scheduler=threads).ran == 3
     assert not (out / ".tmem-lock").exists()
+
+
+def test_a_sweep_takes_its_lock_before_it_looks_at_the_directory(tmp_path, threads):
+    """Held by a sweep that has not made its directory yet: a second is refused, and makes nothing."""
+    sweep_file = tmp_path / "s.toml"
+    sweep_file.write_text(SWEEP)
+    out = tmp_path / "out"
+    with held(out, "lock_beside") as holder:
+        code, stderr, _ = invoke(CliRunner(), "sweep", sweep_file, "--out", out, "--scheduler", threads)
+        one_line_refusal(code, stderr)
+        assert f"another `tmem sweep` (process {holder.pid}) is writing to it" in stderr
+        assert not out.exists()
+    assert run_sweep(loads_sweep(SWEEP, source=str(sweep_file)), out, scheduler=threads).ran == 3
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.toml"]  # the lock beside is gone with its holder
+
+
+@pytest.fixture(scope="module")
+def tcp_threads():
+    """A cluster in this process that other processes reach by TCP."""
+    with LocalCluster(n_workers=1, processes=False, protocol="tcp", dashboard_address=":0") as cluster:
+        yield cluster.scheduler_address
+
+
+def test_two_sweeps_started_at_once_run_each_case_once(tmp_path, tcp_threads):
+    sweep_file = tmp_path / "s.toml"
+    sweep_file.write_text(SWEEP)
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    args = [sys.executable, "-m", "tmem", "sweep", str(sweep_file), "--out", str(out), "--scheduler", tcp_threads]
+    both = [subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env) for _ in range(2)]
+    ran = 0
+    for process in both:
+        stdout, stderr = process.communicate(timeout=300)
+        if process.returncode == 0:
+            ran += int(stdout.split("(")[1].split(" run now")[0])
+        else:
+            one_line_refusal(process.returncode, stderr)
+            assert "is writing to it" in stderr
+    assert ran == 3  # every case once, by one or the other
+    assert list(pd.read_parquet(out / "results.parquet")["case"]) == [0, 1, 2]
 
 
 def test_lock_refuses_a_second_holder_in_this_process_too(tmp_path):

@@ -102,8 +102,12 @@ def test_rerun_replaces_an_earlier_run(tmp_path):
     out = tmp_path / "o"
     runner = CliRunner()
     assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
-    (out / "summary.json").write_text("{}")  # a file the earlier run wrote, changed
-    (out / "velocity.png").unlink()  # and one removed
+    (out / "summary.json").write_text("{}")  # a file the earlier run wrote, changed: the user's now
+    refused = runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)])
+    assert refused.exit_code == 2 and "were changed since it wrote them (summary.json)" in refused.stderr
+    assert (out / "summary.json").read_text() == "{}"
+    (out / "summary.json").unlink()  # removed, as is another: nothing of the user's is left to lose
+    (out / "velocity.png").unlink()
     assert runner.invoke(app, ["run", str(EXAMPLES / "repulsion.toml"), "--out", str(out)]).exit_code == 0
     assert json.loads((out / "summary.json").read_text())["function"] == "repulsion"
     assert (out / "velocity.png").exists()

@@ -51,7 +51,6 @@ def test_redrawn_in_place_the_figures_are_those_tmem_run_drew(run_dir):
     """The same function draws them from the same numbers: the same PNG bytes."""
     drawn = {name: (run_dir / name).read_bytes() for name in FIGURES}
     (run_dir / "velocity.png").unlink()
-    (run_dir / "paths.png").write_bytes(b"stale")
     (run_dir / "animation.gif").write_bytes(b"GIF89a the user's")
     code, stderr, stdout = invoke(run_dir)
     assert code == 0, stderr

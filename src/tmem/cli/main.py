@@ -15,38 +15,16 @@ import sys
 from pathlib import Path
 
 import typer
-from typer.core import TyperGroup
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+from tmem.cli.messages import Commands, error_line
 from tmem.cli.terminal import LazyProgress, summary_table
-
-
-
-def _untyped_flags(command, ctx) -> None:
-    """Show flags (``--help``, ``--version``) in help without a type: Typer would write ``--help <bool>``."""
-    for param in command.get_params(ctx):
-        if getattr(param, "is_flag", False):
-            param.metavar = ""
-
-
-class _Commands(TyperGroup):
-    """Typer's group of commands, each one's flags shown without a type in its help."""
-
-    def get_command(self, ctx, cmd_name):
-        command = super().get_command(ctx, cmd_name)
-        if command is not None:
-            _untyped_flags(command, ctx)
-        return command
-
-    def format_help(self, ctx, formatter):
-        _untyped_flags(self, ctx)
-        super().format_help(ctx, formatter)
-
+from tmem.files.outputs.names import one_line
 
 app = typer.Typer(
-    cls=_Commands, add_completion=False, no_args_is_help=True,
+    cls=Commands, add_completion=False, no_args_is_help=True,
     help="Run a scenario, reproduce the paper, animate or plot a run, sweep many.",
 )  # fmt: skip
 console = Console(stderr=True)
@@ -66,14 +44,18 @@ def _options(
 ) -> None:
     """Run a scenario, reproduce the paper, animate or plot a run, sweep many."""
 
-def _fail(message: str) -> None:
-    console.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
+def _fail(message: str | Exception) -> None:
+    """Say ``message`` as one line on standard error (:func:`tmem.cli.messages.error_line`) and exit with status 2."""
+    if isinstance(message, OSError) and message.filename and message.strerror:
+        message = f"{message.filename}: {message.strerror}"
+    console.print(f"[bold red]error:[/] {escape(error_line(str(message)))}", highlight=False, soft_wrap=True)
     raise typer.Exit(2)
 
 
 def _say(text: str) -> None:
-    """Print ``text`` to standard output as it is: no markup, no highlighting, no wrapping (a path stays whole)."""
-    Console().print(text, markup=False, highlight=False, soft_wrap=True)
+    """Print ``text`` to standard output as one line: no markup, no highlighting, no wrapping (a path stays
+    whole), control characters escaped (:func:`tmem.files.outputs.one_line`)."""
+    Console().print(one_line(text), markup=False, highlight=False, soft_wrap=True)
 
 
 def _resuming(time: float) -> None:
@@ -122,7 +104,7 @@ def run(
             checkpoints.remove()
     except (ScenarioError, OutputError, SimulationError, CheckpointError) as exc:
         progress.close()
-        _fail(str(exc))
+        _fail(exc)
     except KeyboardInterrupt:
         progress.close()
         if checkpoints is None or checkpoints.saved_time is None:
@@ -157,7 +139,7 @@ def paper(
         summaries, _ = run_paper(out, progress=progress)
     except (OutputError, SimulationError) as exc:
         progress.close()
-        _fail(str(exc))
+        _fail(exc)
     progress.close()
     Console().print(summary_table(summaries))
     _say(f"report: {out / 'report.md'}")
@@ -167,21 +149,23 @@ def paper(
 def animate_command(
     run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run directory written by tmem run (a 2-D or 3-D run)."),
     out: Path = typer.Option(
-        None, "--out", "-o", show_default="RUN_DIR/animation.gif", help="Animation file: .gif, or .mp4 with ffmpeg."
+        None, "--out", "-o", show_default="RUN_DIR.gif beside RUN_DIR",
+        help="Animation file: .gif, or .mp4 with ffmpeg; replaced only if tmem animate wrote it.",
     ),
     fps: int = typer.Option(20, help="Frames per second of the animation."),
     max_frames: int = typer.Option(400, help="Most frames drawn; the recorded times are thinned evenly to this many."),
 ) -> None:
     """Animate a run: agents, interaction circles, coupled pairs coloured by strain, and a clock.
 
-    A 3-D run is drawn as a 3-D view beside its projection on (x, y).
+    A 3-D run is drawn as a 3-D view beside its projection on (x, y). The file goes beside the run
+    directory, never into it, as tmem view's and tmem export's do.
     \f
     Parameters
     ----------
     run_dir : Path
         A run directory written by ``tmem run``.
     out : Path or None
-        Animation file (``.gif``, or ``.mp4`` with ffmpeg); default ``RUN_DIR/animation.gif``.
+        Animation file (``.gif``, or ``.mp4`` with ffmpeg); default ``RUN_DIR.gif`` beside the run directory.
     fps : int
         Frames per second.
     max_frames : int
@@ -195,7 +179,7 @@ def animate_command(
     try:
         path = animate(run_dir, out, fps=fps, max_frames=max_frames)
     except (ValueError, OSError) as exc:
-        _fail(str(exc))
+        _fail(exc)
     _say(f"written {path}")
 
 
@@ -222,7 +206,7 @@ def plot_command(
     try:
         paths = redraw(run_dir, out)
     except (ValueError, OSError) as exc:
-        _fail(str(exc))
+        _fail(exc)
     if not paths:
         _say(f"{run_dir}: the run recorded nothing to draw")
         return
@@ -233,9 +217,14 @@ def plot_command(
 def export_command(
     run_dir: Path = typer.Argument(..., help="A run directory written by `tmem run`."),
     to: str = typer.Option(..., "--to", help="mcap: Foxglove's messages in one file; csv: Crazyswarm2-style, a file per agent."),
-    out: Path = typer.Option(None, "--out", "-o", help="Where to write; default RUN_DIR/trajectory.mcap or RUN_DIR/crazyswarm/."),
+    out: Path = typer.Option(
+        None, "--out", "-o", show_default="RUN_DIR.mcap or RUN_DIR-crazyswarm/ beside RUN_DIR",
+        help="Where to write; replaced only if tmem export wrote it.",
+    ),
 ) -> None:
     """Export a run for the field's tools: an MCAP file for Foxglove, or CSV files for Crazyswarm2.
+
+    The export goes beside the run directory, never into it, as tmem view's and tmem animate's do.
 
     \f
     Parameters
@@ -245,14 +234,14 @@ def export_command(
     to : str
         ``mcap`` or ``csv`` (``docs/exchange.md``).
     out : Path or None
-        Where to write; default ``RUN_DIR/trajectory.mcap`` or ``RUN_DIR/crazyswarm/``.
+        Where to write; default ``RUN_DIR.mcap`` or ``RUN_DIR-crazyswarm/`` beside the run directory.
     """
     from tmem.files.exchange import export
 
     try:
         path = export(run_dir, to, out)
     except (ValueError, OSError) as exc:
-        _fail(str(exc))
+        _fail(exc)
     _say(f"written {path}")
 
 
@@ -286,7 +275,7 @@ def sweep_command(
         count = check_workers(workers, scheduler)
         sweep = load_sweep(sweep_file)
     except SweepError as exc:
-        _fail(str(exc))
+        _fail(exc)
     bar = Progress(
         TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} cases"),
         TimeRemainingColumn(), console=console, transient=True, disable=not console.is_terminal,
@@ -297,12 +286,12 @@ def sweep_command(
             outcome = run_sweep(
                 sweep, out, scheduler=scheduler, workers=count,
                 progress=lambda done, total: bar.update(task, completed=done),
-                notify=lambda line: console.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True),
+                notify=lambda line: console.print(f"[yellow]warning:[/] {escape(one_line(line))}", highlight=False, soft_wrap=True),
             )  # fmt: skip
     except (SweepError, OutputError) as exc:
-        _fail(str(exc))
+        _fail(exc)
     except SweepInterrupted as exc:
-        console.print(escape(str(exc)), highlight=False)
+        console.print(escape(one_line(str(exc))), highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
     _say(
         f"{len(outcome.table)} cases ({outcome.ran} run now, {outcome.failed} failed) in {outcome.seconds:.1f} s; "
@@ -320,6 +309,8 @@ def view_command(
     max_frames: int = typer.Option(None, show_default="1000 frames, fewer for large swarms", help="Most recorded times shown."),
 ) -> None:
     """Write a viewer of a run: one HTML file that plays it in a browser, offline.
+
+    The page goes beside the run directory, never into it, as tmem animate's and tmem export's do.
 
     \f
     Parameters
@@ -340,8 +331,8 @@ def view_command(
 
     try:
         path = write_view(run_dir, out, max_agents=max_agents or MAX_AGENTS, max_frames=max_frames)
-    except ValueError as exc:
-        _fail(str(exc))
+    except (ValueError, OSError) as exc:
+        _fail(exc)
     _say(f"written {path}")
 
 

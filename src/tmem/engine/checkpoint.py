@@ -45,6 +45,7 @@ import numpy as np
 
 from tmem import __version__
 from tmem.law.interaction.kernels import FunctionParams
+from tmem.files.arrays import NpzArrays
 from tmem.files.outputs import write_atomically
 from tmem.scenario import Scenario
 from tmem.world.sensing import Sensing
@@ -348,12 +349,15 @@ class Checkpoints:
             raise CheckpointError(f"checkpoint {path}: exists and is not a tmem checkpoint; move it away or choose another --out")
         if not path.exists():
             return None
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                arrays = {key: data[key] for key in data.files}
-            meta = json.loads(str(arrays.pop("meta")))
-            step, builds, by, made_for = int(meta["step"]), int(meta["list_builds"]), str(meta["made_by"]), meta["fingerprint"]
-        except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        damaged = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
+        try:  # the meta first, and only then the arrays: a foreign file is refused before any is read
+            data = NpzArrays(path)
+            with data:
+                meta = json.loads(str(data.read("meta")))
+                step, builds, by, made_for = int(meta["step"]), int(meta["list_builds"]), str(meta["made_by"]), meta["fingerprint"]
+                if by == made_by() and meta.get("format") == FORMAT and made_for == self._fingerprint:
+                    arrays = {key: data.read(key) for key in data.names if key != "meta"}
+        except damaged as exc:
             raise CheckpointError(
                 f"checkpoint {path}: is not a tmem checkpoint, or is damaged ({type(exc).__name__}); move it away or choose another --out"
             ) from None

@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tmem.files.outputs.names import OneLineError
+
 #: A run directory's files that tmem's tools read back (``tmem animate`` and ``tmem export`` need
 #: only the first).
 RUN_FILES = ("trajectory.nc", "summary.json")
@@ -74,13 +76,23 @@ POSITION_ATTRS = {
 
 __all__ = [
     "CONVENTIONS", "FRAME", "FRAME_AXES", "GRID_MAPPING", "GRID_MAPPING_ATTRS", "OVER_AGENTS", "OVER_PAIRS", "POSITION_ATTRS",
-    "RUN_FILES", "TIME_UNITS", "RunReadError", "axis_variables", "check_layout", "components", "open_trajectory", "over_time",
+    "RUN_FILES", "SUMMARY_MAX", "TIME_UNITS", "RunReadError", "axis_variables", "check_layout", "components", "open_trajectory", "over_time",
     "positions", "reading", "run_axes", "run_directory", "short_reason", "trajectory_path",
 ]  # fmt: skip
 
 
-class RunReadError(ValueError):
-    """A run directory or file that cannot be read back; the message is one line."""
+#: The largest ``summary.json`` read (bytes): a summary lists every pair, about 200 bytes each.
+SUMMARY_MAX = 256 * 2**20
+
+
+class RunReadError(OneLineError):
+    """A run directory or file that cannot be read back; the message is one line (control characters escaped).
+
+    Parameters
+    ----------
+    message : str
+        What is wrong.
+    """
 
 
 def run_directory(run_dir: str | Path, command: str, files: tuple[str, ...] = RUN_FILES) -> Path:
@@ -100,6 +112,12 @@ def run_directory(run_dir: str | Path, command: str, files: tuple[str, ...] = RU
         raise RunReadError(f"{command}: {run_dir}: no such folder")
     if not run_dir.is_dir():
         raise RunReadError(f"{command}: {run_dir}: is a file, not a run folder; give the folder tmem run wrote")
+    for name in files:  # only regular files are read, and a summary of bounded size
+        path = run_dir / name
+        if path.exists() and not path.is_file():
+            raise RunReadError(f"{command}: {path}: is not a regular file (a FIFO, a device or a folder)")
+        if name == "summary.json" and path.is_file() and path.stat().st_size > SUMMARY_MAX:
+            raise RunReadError(f"{command}: {path}: is {path.stat().st_size} bytes, more than a run's summary may be ({SUMMARY_MAX} bytes)")
     missing = [name for name in files if not (run_dir / name).is_file()]
     if missing:
         inside = sorted(p for p in run_dir.iterdir() if all((p / name).is_file() for name in files))

@@ -23,6 +23,7 @@ a run lists them as ``[[agents]]`` and loads again without the YAML file.
 from __future__ import annotations
 
 import math
+import reprlib
 from pathlib import Path
 
 from tmem.scenario.agents_table import AGENT_NAME
@@ -34,8 +35,27 @@ KEY = "agents_from"
 LAYOUT = "robots: NAME: {enabled, uri, initial_position: [x, y, z], type}"
 
 
+#: The most characters of a value or a name shown in a message.
+SHOWN = 80
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxdict, _REPR.maxstring, _REPR.maxother = 2, 4, 4, 40, 40
+
+
 def _refuse(where: str, reason: str) -> ScenarioError:
     return ScenarioError(f"{KEY}: {where}: {reason}")
+
+
+def _shown(value: object) -> str:
+    """``value`` as a short ``repr``: nested lists cut after a few items and levels, so that a YAML alias
+    repeated level after level ("billion laughs") is never written out; at most :data:`SHOWN` characters."""
+    text = _REPR.repr(value)
+    return text if len(text) <= SHOWN else text[: SHOWN - 3] + "..."
+
+
+def _name(name: str) -> str:
+    """A robot's name for a message: control characters escaped (a newline cannot start a line), cut short."""
+    text = name if name.isprintable() else repr(name)[1:-1]
+    return text if len(text) <= SHOWN else text[: SHOWN - 3] + "..."
 
 
 def _parse(path: Path, text: str) -> dict:
@@ -57,12 +77,12 @@ def _parse(path: Path, text: str) -> dict:
 
 def _position(path: Path, name: str, robot: object) -> list[float] | None:
     """The robot's ``initial_position`` if it is enabled, ``None`` if not; a malformed entry is refused."""
-    where = f"{path}: robots.{name}"
+    where = f"{path}: robots.{_name(name)}"
     if not isinstance(robot, dict):
         raise _refuse(where, f"must be a table ({LAYOUT.removeprefix('robots: NAME: ')})")
     enabled = robot.get("enabled")
     if not isinstance(enabled, bool):
-        raise _refuse(f"{where}.enabled", f"must be true or false, got {enabled!r}")
+        raise _refuse(f"{where}.enabled", f"must be true or false, got {_shown(enabled)}")
     if not enabled:
         return None
     if not AGENT_NAME.fullmatch(name):
@@ -70,7 +90,7 @@ def _position(path: Path, name: str, robot: object) -> list[float] | None:
     place = robot.get("initial_position")
     numbers = isinstance(place, list) and all(isinstance(v, int | float) and not isinstance(v, bool) for v in place)
     if not numbers or len(place) != 3 or not all(math.isfinite(v) for v in place):
-        raise _refuse(f"{where}.initial_position", f"must be 3 finite numbers [x, y, z] (m), got {place!r}")
+        raise _refuse(f"{where}.initial_position", f"must be 3 finite numbers [x, y, z] (m), got {_shown(place)}")
     return [float(v) for v in place]
 
 
@@ -82,8 +102,8 @@ def _check_plane(path: Path, places: dict[str, list[float]], axes: int) -> None:
             if place[a] != first[1][a]:
                 axis = "xyz"[a]
                 raise _refuse(
-                    f"{path}: robots.{name}.initial_position",
-                    f"{axis} = {place[a]:g} differs from robots.{first[0]}'s {first[1][a]:g}, but the run has "
+                    f"{path}: robots.{_name(name)}.initial_position",
+                    f"{axis} = {place[a]:g} differs from robots.{_name(first[0])}'s {first[1][a]:g}, but the run has "
                     f"space.axes = {axes} (it keeps {'x' if axes == 1 else 'x and y'}); set axes = 3 in [space], "
                     f"or give every enabled robot the same {axis}",
                 )
@@ -131,7 +151,7 @@ def expand(data: dict, directory: Path) -> dict:
         return data
     value = data[KEY]
     if not isinstance(value, str) or not value:
-        raise ScenarioError(f"{KEY}: must be the path of a Crazyswarm2 crazyflies.yaml (a string), got {value!r}")
+        raise ScenarioError(f"{KEY}: must be the path of a Crazyswarm2 crazyflies.yaml (a string), got {_shown(value)}")
     formation = data.get("formation")
     generated = isinstance(formation, dict) and formation.get("kind") != "edges"
     for other, given in (("agents", "agents" in data), ("swarm", "swarm" in data), ("formation", generated)):

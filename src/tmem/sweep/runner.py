@@ -1,6 +1,9 @@
 """Running a sweep on Dask: local by default, or an existing cluster by its scheduler's address.
 
-:func:`run_sweep` opens the output directory (:mod:`tmem.sweep.store`),
+:func:`run_sweep` takes the lock beside the output directory
+(:func:`tmem.files.outputs.lock_beside`) before it looks at the directory: of two sweeps
+started into one directory at the same instant, the second is refused at once.  Under the lock
+it opens the output directory (:mod:`tmem.sweep.store`),
 leaves out the cases already done, groups the others into chunks
 (:func:`tmem.sweep.tasks.plan_chunks`), submits one task per chunk and
 writes rows as tasks finish.  The local cluster and a remote one take the
@@ -32,6 +35,8 @@ from pathlib import Path
 
 import pandas as pd
 
+import tmem.engine  # noqa: F401 - before tmem.law.record (through the tasks), which the engine's driver imports back
+from tmem.files.outputs import lock_beside, update_files
 from tmem.sweep.cluster import check_workers, dask_client, takes_signals
 from tmem.sweep.report import write_report
 from tmem.sweep.spec import Sweep
@@ -133,9 +138,11 @@ def run_sweep(
     started = time.perf_counter()
     out = Path(out)
     workers = check_workers(workers, scheduler)
-    store = ResultStore.check(out, sweep, notify)
-    metrics = store.metrics
+    ResultStore.check(out, sweep, notify)  # a directory that is no sweep's refused before any lock is made for it
     with ExitStack() as held:
+        held.enter_context(lock_beside(out, "sweep"))  # before anything about the directory is decided
+        store = ResultStore.check(out, sweep, notify)
+        metrics = store.metrics
         if store.exists:
             held.enter_context(store.opened())  # the lock, before reading what is done
         done_before = store.done_cases()
@@ -157,7 +164,8 @@ def run_sweep(
         if not store.exists:  # a sweep of no cases
             held.enter_context(store.opened())
         table = store.finish()
-        write_report(table, sweep, out)
+        with update_files(out) as folder:  # the report replaces an earlier one only while it is as tmem wrote it
+            write_report(table, sweep, folder)
     return SweepOutcome(table=table, ran=ran, failed=int(table["error"].notna().sum()), seconds=time.perf_counter() - started)
 
 

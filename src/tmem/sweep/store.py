@@ -23,15 +23,18 @@ The directory appears whole: ``sweep.toml``, ``sweep.json``, the manifest
 ``.tmem-output.json`` and ``parts/`` are written into a temporary directory
 that is renamed into place (a directory holding only ``sweep.toml``, as an
 earlier tmem could leave when killed, is taken up again).  While a sweep
-writes, it holds the directory's lock (:func:`tmem.files.outputs.lock`); it removes
-what killed processes left (temporary parts, a temporary ``results.parquet``)
-when it takes the lock.
+writes, it holds the lock beside the directory (taken by :func:`tmem.sweep.runner.run_sweep`
+before the directory is looked at) and the directory's own (:func:`tmem.files.outputs.lock`); it
+removes what killed processes left (temporary parts, a temporary ``results.parquet``) when it
+takes the lock.  Only regular files are read, each of bounded size: a FIFO or a device under the
+name of a file of rows is set aside as corrupt, never opened.
 """
 
 from __future__ import annotations
 
 import json
 import re
+import stat
 import uuid
 import warnings
 from collections.abc import Callable, Iterator
@@ -52,12 +55,16 @@ from tmem.files.outputs import (
     remove_leftovers,
     write_atomically,
 )
+from tmem.files.outputs.digests import read_regular
+from tmem.scenario.files import MAX_FILE_BYTES
 from tmem.sweep.spec import METRIC_TYPES, Sweep
 
 RESULTS = "results.parquet"
 PARTS = "parts"
 #: Appended to the name of a file of rows that cannot be read, set aside in the sweep's directory.
 CORRUPT = ".corrupt"
+#: The largest ``sweep.json`` read (bytes).
+_IDENTITY_MAX = 1 << 16
 #: What reading a damaged Parquet file may raise.
 _UNREADABLE = (pa.ArrowException, OSError, ValueError, TypeError, KeyError, IndexError, MemoryError, NotImplementedError)
 #: Temporary files of an earlier tmem (no process id in the name), removed under the lock.
@@ -138,7 +145,7 @@ class ResultStore:
                     mark_directory(self.out, "sweep")
                 (self.out / PARTS).mkdir(exist_ok=True)
                 for folder in (self.out, self.out / PARTS):
-                    remove_leftovers(folder)
+                    remove_leftovers(folder, everything=True)  # under the sweep's locks: no writer but this one
                     for stale in folder.iterdir():
                         if _OLD_TEMPORARY.fullmatch(stale.name):
                             stale.unlink()
@@ -160,6 +167,8 @@ class ResultStore:
     def _read(self, path: Path) -> pd.DataFrame | None:
         """The rows in ``path``; None once it is set aside, if it cannot be read whole or its rows are not this sweep's."""
         try:
+            if path.is_symlink() or not stat.S_ISREG(path.stat().st_mode):
+                raise ValueError("it is not a regular file")
             frame = pd.read_parquet(path, page_checksum_verification=True)
             self._check_rows(frame)
         except _UNREADABLE as exc:
@@ -244,7 +253,7 @@ class ResultStore:
         if parts.is_dir():
             for part in parts.glob("part-*.parquet"):
                 part.unlink()
-            remove_leftovers(parts)
+            remove_leftovers(parts, everything=True)
             parts.rmdir()
         return frame
 
@@ -263,7 +272,7 @@ def _only_a_first_sweep_toml(out: Path, sweep: Sweep) -> bool:
             return False
         if PARTS in names and ((out / PARTS).is_symlink() or any((out / PARTS).iterdir())):
             return False
-        return (out / "sweep.toml").read_text(encoding="utf-8") == sweep.text
+        return read_regular(out / "sweep.toml", MAX_FILE_BYTES).decode("utf-8") == sweep.text
     except (OSError, ValueError):
         return False
 
@@ -274,7 +283,7 @@ def _check_identity(out: Path, sweep: Sweep) -> None:
     if not identity.exists():
         return  # new or empty
     try:
-        fingerprint = json.loads(identity.read_text(encoding="utf-8"))["fingerprint"]
+        fingerprint = json.loads(read_regular(identity, _IDENTITY_MAX).decode("utf-8"))["fingerprint"]
     except (OSError, ValueError, KeyError, TypeError):
         raise OutputError(f"--out {out}: its sweep.json cannot be read; choose another directory") from None
     if fingerprint != sweep.fingerprint:

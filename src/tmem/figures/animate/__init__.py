@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tmem.files.outputs import check_file, replace_file
+from tmem.files.outputs import beside, check_file, replace_file
 from tmem.figures.animate.frames import read_frames
 from tmem.figures.animate.scene import positions, scene, update
 from tmem.figures.animate.writers import abandon, writer_for
@@ -66,7 +66,7 @@ def animate(
         Run directory holding ``trajectory.nc`` (or the path of that file).
     out : str or Path, optional
         Output file, ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).  Default:
-        ``animation.gif`` in the run directory.
+        ``NAME.gif`` beside the run directory ``NAME`` (:func:`tmem.files.outputs.beside`).
     fps : float
         Frames per second of the animation.
     max_frames : int
@@ -96,10 +96,10 @@ def animate(
         if not value > 0:
             raise ValueError(f"animate: {name} must be positive, got {value}")
     label = "--out " if out is not None else ""
-    out = Path(out) if out is not None else (run_dir.parent if run_dir.suffix == ".nc" else run_dir) / "animation.gif"
-    run = read_frames(run_dir, max_frames)
+    out = Path(out) if out is not None else beside(run_dir, ".gif")
+    check_file(out, label=label)  # before anything is read: what stands at out is never opened unless tmem wrote it
     writer = writer_for(out, fps)
-    check_file(out, label=label)
+    run = read_frames(run_dir, max_frames)
     _write(run, writer, out, label, dpi)
     return out
 

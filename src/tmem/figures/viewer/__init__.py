@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tmem.files.outputs import check_file, replace_file
+from tmem.files.outputs import beside, check_file, replace_file
 from tmem.files.trajectory_file import RunReadError
 from tmem.figures.viewer.data import MAX_AGENTS, read_view
 from tmem.figures.viewer.page import VIEW_MARK, render
@@ -29,17 +29,15 @@ __all__ = ["MAX_AGENTS", "RunReadError", "default_out", "write_view"]
 def default_out(run_dir: str | Path) -> Path:
     """Where the page of ``run_dir`` goes by default: ``NAME.html`` beside the run directory ``NAME``.
 
-    Beside, not inside: a file added to a run directory would make ``tmem run``
-    refuse to replace it (:mod:`tmem.files.outputs`).
+    Beside, not inside, as every file derived from a run (:func:`tmem.files.outputs.beside`): a
+    file added to a run directory would make ``tmem run`` refuse to replace it.
 
     Parameters
     ----------
     run_dir : str or Path
         The run directory.
     """
-    run_dir = Path(run_dir).absolute()
-    resolved = run_dir.resolve()
-    return resolved.parent / f"{resolved.name or 'run'}.html"
+    return beside(run_dir, ".html")
 
 
 def write_view(run_dir: str | Path, out: str | Path | None = None, max_agents: int = MAX_AGENTS, max_frames: int | None = None) -> Path:

@@ -17,8 +17,9 @@ from pathlib import Path
 
 __all__ = ["DEFAULT_OUT", "FORMATS", "export"]
 
-#: The formats and where each goes in the run directory when no ``out`` is given.
-DEFAULT_OUT = {"mcap": "trajectory.mcap", "csv": "crazyswarm"}
+#: The formats, and what each appends to the run directory's name when no ``out`` is given: the
+#: export goes beside the run directory ``NAME``, as ``NAME.mcap`` or the folder ``NAME-crazyswarm``.
+DEFAULT_OUT = {"mcap": ".mcap", "csv": "-crazyswarm"}
 FORMATS = tuple(DEFAULT_OUT)
 
 
@@ -32,8 +33,9 @@ def export(run_dir: str | Path, to: str, out: str | Path | None = None) -> Path:
     to : str
         One of :data:`FORMATS`.
     out : str or Path, optional
-        Where to write; by default :data:`DEFAULT_OUT` inside ``run_dir``.  An existing ``out``
-        is replaced only if ``tmem export`` wrote it.
+        Where to write; by default beside the run directory ``NAME``: ``NAME.mcap``, or the folder
+        ``NAME-crazyswarm`` (:data:`DEFAULT_OUT`, :func:`tmem.files.outputs.beside`).  An existing
+        ``out`` is replaced only if ``tmem export`` wrote it and it is still as written.
 
     Raises
     ------
@@ -42,15 +44,14 @@ def export(run_dir: str | Path, to: str, out: str | Path | None = None) -> Path:
         (:func:`~tmem.files.exchange.recording.read_recording`), an ``out`` that may not be written
         (:class:`tmem.files.outputs.OutputError`).
     """
-    from tmem.files.outputs import check_directory, check_file
+    from tmem.files.outputs import beside, check_directory, check_file
     from tmem.files.exchange.recording import read_recording
 
     if to not in FORMATS:
         raise ValueError(f"--to: must be one of {', '.join(FORMATS)}, got {to!r}")
     run_dir = Path(run_dir)
     label = "--out " if out is not None else ""
-    folder = run_dir.parent if run_dir.suffix == ".nc" else run_dir  # a trajectory.nc given for its folder
-    target = Path(out) if out is not None else folder / DEFAULT_OUT[to]
+    target = Path(out) if out is not None else beside(run_dir, DEFAULT_OUT[to])
     if to == "mcap":
         from tmem.files.exchange.foxglove import EXPORT_MARK, export_mcap
 

@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 from tmem import __version__
-from tmem.files.outputs.names import _NAME_MAX, _too_long, is_leftover
+from tmem.files.outputs.digests import read_regular, record, unchanged
+from tmem.files.outputs.names import _NAME_MAX, WRITING, OneLineError, _too_long, is_leftover, one_line
 
 #: The manifest every command writes into its output directory.
 MANIFEST = ".tmem-output.json"
@@ -23,34 +25,70 @@ LOCK = ".tmem-lock"
 #: Commands that write output directories, as their manifests name them.
 COMMANDS = ("run", "paper", "sweep", "plot", "export")
 #: Entries of an output directory that are tmem's bookkeeping, not its products.
-_BOOKKEEPING = frozenset({MANIFEST, LOCK})
+_BOOKKEEPING = frozenset({MANIFEST, LOCK, WRITING})
 #: The largest manifest read (bytes).
 _MANIFEST_MAX = 1 << 20
 #: Names shown in a message before "and N more".
 _SHOWN = 6
+_SHA256 = re.compile(r"[0-9a-f]{64}")
 
 
-class OutputError(ValueError):
-    """An output that cannot be written; the message is one line."""
+class OutputError(OneLineError):
+    """An output that cannot be written; the message is one line (control characters escaped).
+
+    Parameters
+    ----------
+    message : str
+        What is wrong.
+    """
 
 
 @dataclass(frozen=True)
 class Manifest:
-    """What ``.tmem-output.json`` says: the command that wrote the directory and the files it wrote."""
+    """What ``.tmem-output.json`` says: the command that wrote the directory, the files it wrote, their digests.
+
+    Attributes
+    ----------
+    command : str
+        The command, one of :data:`COMMANDS`.
+    files : frozenset of str or None
+        The files it wrote, as paths relative to the directory; None: the command does not list
+        them (a sweep's directory grows).
+    digests : dict of str to str or None
+        The SHA-256 of each file as written (:mod:`tmem.files.outputs.digests`); None in a
+        manifest of an earlier tmem, which keeps none.
+    written_ns : int or None
+        For such a manifest, when it was last modified (ns since the epoch); else None.
+    """
 
     command: str
-    files: frozenset[str] | None  # None: the command does not list them (a sweep grows)
-
-
-def _show(name: str) -> str:
-    """A name as one printable line."""
-    return name if name.isprintable() else ascii(name)[1:-1]
+    files: frozenset[str] | None
+    digests: dict[str, str] | None = None
+    written_ns: int | None = None
 
 
 def _listing(names: list[str]) -> str:
-    shown = [_show(n) for n in names[:_SHOWN]]
+    shown = [one_line(n) for n in names[:_SHOWN]]
     more = len(names) - len(shown)
     return ", ".join(shown) + (f" and {more} more" if more > 0 else "")
+
+
+def _parse_manifest(data: dict, info: os.stat_result) -> Manifest:
+    command = data["command"]
+    files = data.get("files")
+    digests = data.get("sha256")
+    if command not in COMMANDS:
+        raise ValueError
+    if files is not None:
+        if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+            raise ValueError
+        files = frozenset(files)
+    if "sha256" not in data:  # an earlier tmem's: no digests, judged by the manifest's time
+        return Manifest(command, files, None, info.st_mtime_ns)
+    if not isinstance(digests, dict) or not all(isinstance(k, str) and isinstance(v, str) and _SHA256.fullmatch(v)
+                                                for k, v in digests.items()):  # fmt: skip
+        raise ValueError
+    return Manifest(command, files, dict(digests), None)
 
 
 def _read_manifest(directory: Path) -> Manifest | None:
@@ -61,20 +99,31 @@ def _read_manifest(directory: Path) -> Manifest | None:
             return Manifest("sweep", None)
         return None
     try:
-        if path.is_symlink() or not path.is_file() or path.stat().st_size > _MANIFEST_MAX:
-            raise ValueError  # a FIFO, a device, or too big to be ours: not read
-        data = json.loads(path.read_text(encoding="utf-8"))
-        command = data["command"]
-        files = data.get("files")
-        if command not in COMMANDS:
-            raise ValueError
-        if files is not None:
-            if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
-                raise ValueError
-            files = frozenset(files)
-    except (OSError, ValueError, KeyError, TypeError):
+        data = read_regular(path, _MANIFEST_MAX)
+        return _parse_manifest(json.loads(data.decode("utf-8")), os.lstat(path))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
         raise _refuse(directory, f"its {MANIFEST} cannot be read; choose another --out or remove it") from None
-    return Manifest(command, files)
+
+
+def changed_files(directory: Path, manifest: Manifest, names: frozenset[str] | list[str], prefix: str = "") -> list[str]:
+    """Those of ``names`` (in ``directory``) that are no longer as tmem wrote them, as the manifest lists them.
+
+    Parameters
+    ----------
+    directory : Path
+        The folder the names are in.
+    manifest : Manifest
+        The manifest listing them, under ``prefix + name``.
+    names : collection of str
+        The files to judge (paths relative to ``directory``); folders (a final ``/``) are skipped.
+    prefix : str
+        Put before each name in the manifest (``"fig9/"`` for a run of a paper's output).
+    """
+    digests = manifest.digests or {}
+    return sorted(
+        name for name in names
+        if not name.endswith("/") and not unchanged(directory / name, digests.get(prefix + name), manifest.written_ns)
+    )  # fmt: skip
 
 
 def _top_entries(directory: Path) -> list[str]:
@@ -179,24 +228,40 @@ def _check_directory(out: Path, command: str, adopt: Callable[[Path], bool] | No
             return out
         if manifest is None or manifest.command != command:
             raise _refuse(out, f"holds {describe(out)}; choose another --out or remove it")
-        if manifest.files is None:
-            return out
-        others = sorted(f for f in _files_below(out) if f not in manifest.files)
+        if manifest.files is None:  # a sweep's: what it will replace (its report) must still be as written
+            others, edited = [], changed_files(out, manifest, list(manifest.digests or ()))
+        else:
+            others = sorted(f for f in _files_below(out) if f not in manifest.files)
+            edited = [] if others else changed_files(out, manifest, manifest.files)
     except OSError as exc:
         raise _refuse(out, f"cannot be read ({exc.strerror or exc})") from None
-    if others:
-        raise _refuse(
-            out,
-            f"holds a `tmem {command}` output and files it did not write ({_listing(others)}); "
-            "choose another --out, or move them out first",
-        )
+    for found, what in ((others, "and files it did not write"), (edited, "whose files were changed since it wrote them")):
+        if found:
+            raise _refuse(out, f"holds a `tmem {command}` output {what} ({_listing(found)}); choose another --out, or move them out first")
     return out
+
+
+def manifest_text(command: str, files: list[str] | None, digests: dict[str, str]) -> str:
+    """The text of a manifest: the command, tmem's version, the files (or None) and their digests.
+
+    Parameters
+    ----------
+    command : str
+        The command that wrote the directory, one of :data:`COMMANDS`.
+    files : list of str or None
+        The files it wrote; None for a directory that grows (a sweep's).
+    digests : dict of str to str
+        The SHA-256 of each file it wrote that it may replace (:func:`tmem.files.outputs.digests.record`).
+    """
+    data = {"command": command, "tmem": __version__, "files": None if files is None else sorted(files),
+            "sha256": dict(sorted(digests.items()))}  # fmt: skip
+    return json.dumps(data, indent=1) + "\n"
 
 
 def _write_manifest(directory: Path, command: str, listed: bool = True) -> None:
     files = sorted(_files_below(directory)) if listed else None
-    data = {"command": command, "tmem": __version__, "files": files}
-    (directory / MANIFEST).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    text = manifest_text(command, files, record(directory, files or []))
+    (directory / MANIFEST).write_text(text, encoding="utf-8")
 
 
 def _cannot_write(out: Path, exc: OSError) -> OutputError:
@@ -204,5 +269,4 @@ def _cannot_write(out: Path, exc: OSError) -> OutputError:
 
 
 def _write_manifest_file(path: Path, command: str) -> None:
-    data = {"command": command, "tmem": __version__, "files": None}
-    path.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    path.write_text(manifest_text(command, None, {}), encoding="utf-8")

@@ -1,46 +1,72 @@
-"""Atomic replacement: output directories and files written under a temporary name, renamed into place when complete."""
+"""Atomic replacement: output directories and files written in a temporary directory, renamed into place when complete.
+
+Every temporary directory is held by its writer's lock while it is written
+(:func:`tmem.files.outputs.names.make_partial`), so that no other tmem takes it for a leftover.
+"""
 
 from __future__ import annotations
 
 import errno
 import os
-import shutil
+import stat
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from tmem.files.outputs.manifest import MANIFEST, OutputError, _cannot_write, _write_manifest, _write_manifest_file, check_directory
-from tmem.files.outputs.names import _NAME_MAX, _too_long, partial_name, remove_leftovers
+from tmem.files.outputs.names import (
+    _NAME_MAX, _too_long, discard, make_partial, missing_parents, release, remove_leftovers, remove_made,
+)  # fmt: skip
 from tmem.files.outputs.signals import _signals_held
 
 #: The mark of a file written by ``tmem animate`` (a GIF comment, MP4 metadata).
 ANIMATE_MARK = "written by tmem animate"
+#: Bytes read from the start and from the end of an existing file, looking for a mark.
+_HEAD, _TAIL = 1 << 16, 1 << 20
 
 
 # --------------------------------------------------------------------------------------------
 # Directories
 
 
-def _missing_parents(out: Path) -> list[Path]:
-    return [p for p in reversed(out.absolute().parents) if not p.exists()]
+@contextmanager
+def _partial_beside(out: Path) -> Iterator[Path]:
+    """A new temporary directory beside ``out``, held for the block (parents made as needed, dead
+    writers' leftovers removed); on an error or an interruption it is removed, with the parents made.
+    The block may rename it to ``out``; whatever it leaves at the temporary name is removed."""
+    made = missing_parents(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        remove_leftovers(out.parent)
+        tmp, fd = make_partial(out.parent, out.name)
+    except OSError as exc:
+        remove_made(made)
+        raise _cannot_write(out, exc) from None
+    try:
+        yield tmp
+    except BaseException:
+        discard(tmp, fd)
+        remove_made(made)
+        raise
+    if tmp.exists():
+        discard(tmp, fd)
+    else:  # renamed into place: its lock file goes
+        release(out, fd)
 
 
-def _remove_made(directories: list[Path]) -> None:
-    for directory in reversed(directories):
+def _swap(out: Path, tmp: Path) -> None:
+    """Put ``tmp`` in ``out``'s place; the old ``out`` is moved into a held temporary directory and removed
+    with it (a process killed meanwhile leaves that to the next writer).  If the swap fails, ``out`` stays."""
+    bin_, fd = make_partial(out.parent, out.name)
+    try:
+        out.rename(bin_ / "old")
         try:
-            directory.rmdir()
-        except OSError:
-            return
-
-
-def _new_partial_directory(out: Path) -> Path:
-    while True:
-        tmp = out.parent / partial_name(out.name)
-        try:
-            tmp.mkdir()  # with the umask's permissions, like any directory the user makes
-            return tmp
-        except FileExistsError:
-            continue
+            tmp.rename(out)
+        except BaseException:
+            (bin_ / "old").rename(out)
+            raise
+    finally:
+        discard(bin_, fd)
 
 
 @contextmanager
@@ -48,8 +74,8 @@ def replace_directory(out: str | Path, command: str) -> Iterator[Path]:
     """Yield a temporary directory that becomes ``out`` only if the block completes.
 
     ``out`` is checked first (:func:`check_directory`) and again just before
-    it is replaced.  On success the manifest listing every file written is
-    added and the temporary directory takes ``out``'s place; on any error or
+    it is replaced.  On success the manifest listing every file written, with
+    its digest, is added and the temporary directory takes ``out``'s place; on any error or
     interruption it is removed, with the parent directories made for it.
     File system errors become :class:`OutputError`.
 
@@ -61,25 +87,18 @@ def replace_directory(out: str | Path, command: str) -> Iterator[Path]:
         The command writing it, as its manifest names it: ``"run"`` or ``"paper"``.
     """
     out = check_directory(out, command)
-    tmp, missing = _partial_beside(out)
     try:
-        yield tmp
-        _write_manifest(tmp, command)
-        with _signals_held():
-            check_directory(out, command)  # what was there may have changed while we worked
-            old = None
-            if out.exists():
-                old = out.parent / partial_name(out.name)
-                out.rename(old)
-            tmp.rename(out)
-            if old is not None:
-                shutil.rmtree(old, ignore_errors=True)
-    except BaseException as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        _remove_made(missing)
-        if isinstance(exc, OSError):
-            raise _cannot_write(out, exc) from None
-        raise
+        with _partial_beside(out) as tmp:
+            yield tmp
+            _write_manifest(tmp, command)
+            with _signals_held():
+                check_directory(out, command)  # what was there may have changed while we worked
+                if out.exists():
+                    _swap(out, tmp)
+                else:
+                    tmp.rename(out)
+    except OSError as exc:
+        raise _cannot_write(out, exc) from None
 
 
 @contextmanager
@@ -99,23 +118,21 @@ def create_directory(out: Path, command: str) -> Iterator[Path]:
     command : str
         The command writing it, as its manifest names it (``"sweep"``).
     """
-    tmp, missing = _partial_beside(out)
     try:
-        yield tmp
-        _write_manifest(tmp, command, listed=False)
-        with _signals_held():
-            try:
-                tmp.rename(out)  # onto an empty directory too, atomically
-            except OSError as exc:
-                if exc.errno in (errno.ENOTEMPTY, errno.EEXIST):
-                    raise FileExistsError(errno.EEXIST, "filled meanwhile", str(out)) from None
-                raise
-    except BaseException as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        _remove_made(missing)
-        if isinstance(exc, OSError) and not isinstance(exc, FileExistsError):
-            raise _cannot_write(out, exc) from None
+        with _partial_beside(out) as tmp:
+            yield tmp
+            _write_manifest(tmp, command, listed=False)
+            with _signals_held():
+                try:
+                    tmp.rename(out)  # onto an empty directory too, atomically
+                except OSError as exc:
+                    if exc.errno in (errno.ENOTEMPTY, errno.EEXIST):
+                        raise FileExistsError(errno.EEXIST, "filled meanwhile", str(out)) from None
+                    raise
+    except FileExistsError:
         raise
+    except OSError as exc:
+        raise _cannot_write(out, exc) from None
 
 
 def mark_directory(directory: Path, command: str) -> None:
@@ -135,7 +152,7 @@ def mark_directory(directory: Path, command: str) -> None:
 
 
 def write_atomically(path: Path, write: Callable[[Path], object]) -> None:
-    """Call ``write(tmp)`` for a temporary path beside ``path`` (same suffix), then rename it to ``path``.
+    """Call ``write(tmp)`` for a temporary path (same name, in a held temporary directory beside ``path``), then rename it to ``path``.
 
     Parameters
     ----------
@@ -145,28 +162,35 @@ def write_atomically(path: Path, write: Callable[[Path], object]) -> None:
         ``write(tmp)`` writes the whole file at ``tmp``; what it returns is
         ignored.  If it raises, ``path`` is left as it was.
     """
-    tmp = path.with_name(partial_name(path.name, path.suffix))
+    folder, fd = make_partial(path.parent, path.name)
     try:
+        tmp = folder / path.name
         write(tmp)
         os.replace(tmp, path)
     finally:
-        tmp.unlink(missing_ok=True)
+        discard(folder, fd)
 
 
 def _has_mark(path: Path, mark: bytes) -> bool:
-    """Whether ``mark`` is in the first 64 KiB or the last 1 MiB of ``path`` (GIF comment, MP4 metadata)."""
+    """Whether ``mark`` is in the first 64 KiB or the last 1 MiB of the regular file ``path`` (GIF comment, MP4 metadata)."""
     try:
-        with path.open("rb") as f:
-            head = f.read(1 << 16)
-            f.seek(max(0, path.stat().st_size - (1 << 20)))
-            tail = f.read()
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError:
         return False
+    with os.fdopen(fd, "rb") as f:
+        size = os.fstat(fd)
+        if not stat.S_ISREG(size.st_mode):
+            return False
+        head = f.read(_HEAD)
+        f.seek(max(0, size.st_size - _TAIL))
+        tail = f.read(_TAIL)
     return mark in head or mark in tail
 
 
 def check_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out ") -> Path:
-    """Refuse a file ``out`` that may not be written: a directory, a link, or a file without ``mark``; return it.
+    """Refuse a file ``out`` that may not be written: a directory, a link, a FIFO or device, or a file without ``mark``; return it.
+
+    Reads at most 64 KiB and 1 MiB of an existing regular file, and nothing of anything else.
 
     Parameters
     ----------
@@ -204,17 +228,24 @@ def _check_file(out: Path, mark: str, where: str) -> Path:
     for parent in out.absolute().parents:
         if parent.exists() and not parent.is_dir():
             raise OutputError(f"{where}: {parent} is a file, not a directory")
-    if out.exists() and not _has_mark(out, mark.encode()):
+    try:
+        kind = os.lstat(out).st_mode
+    except FileNotFoundError:
+        return out
+    if not stat.S_ISREG(kind):
+        raise OutputError(f"{where}: exists and is not a regular file (a FIFO, a device or a socket); name a file")
+    if not _has_mark(out, mark.encode()):
         raise OutputError(f"{where}: exists and was not {mark}; choose another --out or remove it")
     return out
 
 
 @contextmanager
 def replace_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out ") -> Iterator[Path]:
-    """Yield a temporary path (with ``out``'s suffix) that becomes ``out`` only if the block completes.
+    """Yield a temporary path (``out``'s name, in a held temporary directory beside it) that becomes ``out``
+    only if the block completes.
 
     ``out`` is checked first (:func:`check_file`) and again just before it is
-    replaced; on any error or interruption the temporary file is removed,
+    replaced; on any error or interruption the temporary directory is removed,
     with the parent directories made for it.
 
     Parameters
@@ -227,31 +258,11 @@ def replace_file(out: str | Path, mark: str = ANIMATE_MARK, label: str = "--out 
         Put before ``out`` in messages, such as ``"--out "``.
     """
     out = check_file(out, mark, label)
-    missing = _missing_parents(out)
-    tmp = out.with_name(partial_name(out.name, out.suffix))
     try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        remove_leftovers(out.parent)
-        yield tmp
-        with _signals_held():
-            check_file(out, mark, label)
-            os.replace(tmp, out)
-    except BaseException as exc:
-        tmp.unlink(missing_ok=True)
-        _remove_made(missing)
-        if isinstance(exc, OSError):
-            raise OutputError(f"{label}{out}: cannot be written ({exc.strerror or exc})") from None
-        raise
-
-
-def _partial_beside(out: Path) -> tuple[Path, list[Path]]:
-    """A new partial directory beside ``out`` (its parents made as needed, dead writers' leftovers
-    removed), and the parents that had to be made, to remove again if the writing fails."""
-    missing = _missing_parents(out)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        remove_leftovers(out.parent)
-        return _new_partial_directory(out), missing
+        with _partial_beside(out) as folder:
+            yield folder / out.name
+            with _signals_held():
+                check_file(out, mark, label)
+                os.replace(folder / out.name, out)
     except OSError as exc:
-        _remove_made(missing)
-        raise _cannot_write(out, exc) from None
+        raise OutputError(f"{label}{out}: cannot be written ({exc.strerror or exc})") from None
