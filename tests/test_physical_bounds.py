@@ -82,6 +82,16 @@ def test_the_inner_loop_poles_are_python_controls(kp, kd, damping, h):
     np.testing.assert_allclose(np.sort_complex(loop_poles(kp, kd, damping, tau, h)), expected, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 30.0, 1e4])
+def test_the_small_exponential_is_scipys(scale):
+    from scipy.linalg import expm
+
+    from tmem.scenario.bounds import exponential
+
+    m = scale * np.array([[0.0, 1.0, 0.0, 0.0], [-2.0, -0.3, 1.0, 0.0], [0.0, 0.0, -1.0, 1.0], [0.0, 0.0, 0.0, 0.0]])
+    np.testing.assert_allclose(exponential(m), expm(m), rtol=1e-12, atol=1e-14 * np.abs(expm(m)).max())
+
+
 @pytest.mark.parametrize("kp, grows", [(11.0, False), (17.0, True)])
 def test_the_stability_bound_is_the_compiled_quadrotors(kp, grows):
     """The Crazyflie's attitude loop is stable below kp = 13.89 /s at h = 2 ms (the bound's figure, on

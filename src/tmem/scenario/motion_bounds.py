@@ -20,8 +20,9 @@ from tmem.scenario.tables import FieldError
 if TYPE_CHECKING:
     from tmem.scenario.schema import Scenario
 
-#: Most listed agents whose every pair's closing speed is taken; beyond, the two largest speeds' sum.
-PAIRWISE = 2000
+#: Most listed agents whose every pair's closing speed is taken (n^2 differences); beyond, the two
+#: largest speeds' sum, an upper bound.
+PAIRWISE = 200
 
 
 class Speed(NamedTuple):

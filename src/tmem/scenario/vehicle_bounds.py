@@ -104,10 +104,10 @@ def _check_loops(scenario: Scenario) -> list[Doubt]:
         if not largest < 1.0:
             stable = _largest_stable(radius, gain)
             blame, value = (field, gain) if stable > 0.0 else (rate_field, rate_gain)
+            where = f"stable for {field.split('.')[1]} below {stable:.4g}" if stable > 0.0 else "unstable at any gain"
             raise FieldError(blame, f"{value:g} makes {name} unstable: linearised at hover, through the motors' lag "
                              f"tau_m = {m.tau_m:g} s and sampled every {h:g} s, its largest pole has |z| = "
-                             f"{largest:.4g}, outside the unit circle (here stable for {field.split('.')[1]} "
-                             f"below {stable:.4g})")  # fmt: skip
+                             f"{largest:.4g}, outside the unit circle (here {where})")  # fmt: skip
         decay = slowest_decay(np.array([largest]), h)
         if decay < im_r:
             doubts.append(Doubt(field, f"{gain:g}: {name}'s slowest mode decays at {decay:.3g} /s, slower than the slow "
