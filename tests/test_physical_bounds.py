@@ -139,7 +139,7 @@ def _trim(theta: float, frame) -> tuple[float, float]:
 def test_the_airspeed_limit_is_the_rigid_bodys_trim(share, tolerance):
     """The fastest level airspeed of the rigid body whose rotors stay at or below share x o_max: its
     own trim (lean and rotor speed found from (Q1)'s forces, the rotors' drag and inflow in) is
-    66.1 m/s at o_max, where the bound's first-order figure is 67.4 m/s; 54.1 m/s at 0.9 o_max, 49.2."""
+    66.1 m/s at o_max, where the bound's first-order figure is 67.4 m/s; 54.0 m/s at 0.9 o_max, 49.2."""
     from scipy.optimize import brentq
 
     from tmem.vehicles.quadrotor import QuadrotorModel

@@ -240,17 +240,14 @@ def simulate(
     record
         ``False`` records nothing but the end state (for benchmarks).
     sensing
-        Fields of the measurement stage's record (:class:`tmem.world.sensing.Sensing`) set over the ones of
-        the scenario's ``[sensing]`` table, for effects the table does not name; given, even empty,
-        the run takes the sensed path.  By default the table decides: without effects, every agent
+        Keys of the ``[sensing]`` table, set in the scenario over its own and checked as the table
+        is, and fields of the measurement stage's record (:class:`tmem.world.sensing.Sensing`) that
+        no key sets, for effects the table does not name (finite numbers); given, even empty, the
+        run takes the sensed path.  By default the table decides: without effects, every agent
         knows every state exactly.
     checkpoints
         Save the run's state at these checkpoints (:mod:`tmem.engine.checkpoint`), and go on from
         the one a killed run of the same scenario left; default: none.
-
-    The overrides of the ``[sensing]`` table's keys are set in the scenario and meet its every check,
-    as in a file; the others must be fields of the measurement stage no key sets
-    (:func:`tmem.scenario.sensing_table.with_overrides`).
 
     Returns
     -------
