@@ -217,8 +217,6 @@ REFUSED: dict[str, tuple[dict, str]] = {
     "linear start tilt 3 rad": (changed(FIG9, "agents.0.tilt", 3.0), "agents[0].tilt"),
     "linear start tilt -1.6 rad": (changed(FIG9, "agents.1.tilt", -1.6), "agents[1].tilt"),
     "linear tilt rate 100 rad/s": (changed(FIG9, "agents.0.tilt_rate", 100.0), "agents[0].tilt_rate"),
-    "tilt limit 2 rad": (changed(FIG9, "interaction.c_max", 2.0), "interaction.c_max"),
-    "tilt limit pi/2": (changed(FIG9, "interaction.c_max", math.pi / 2), "interaction.c_max"),
     # the coupling window against one step's closing distance (4.5 m/s x dt)
     "eps 0.001 m at dt 0.01 s": (changed(changed(FIG9, "interaction.eps", 0.001), "simulation.dt", 0.01), "interaction.eps"),
     "eps 0.02 m at dt 0.01 s": (changed(changed(FIG9, "interaction.eps", 0.02), "simulation.dt", 0.01), "interaction.eps"),
@@ -226,6 +224,8 @@ REFUSED: dict[str, tuple[dict, str]] = {
     # starts against the reach per step (R + R_j) / dt
     "start at 1e9 m/s": (changed(FIG9, "agents.0.velocity", 1e9), "agents[0].velocity"),
     "start at 5e5 m/s": (changed(FIG9, "agents.1.velocity", 5e5), "agents[1].velocity"),
+    "walled box, 50 m a step": (changed(changed(GAS, "space", {"axes": 2, "walls": True, "box": [600.0, 600.0]}),
+                                        "swarm", {"n": 50, "seed": 1, "speed_rms": 2500.0}), "swarm.speed_rms"),
     "swarm at 1e4 m/s RMS": (changed(SHORT | {"agents": []}, "swarm", {"n": 10, "region": [500.0], "speed_rms": 1e4})
                              | {"simulation": {"dt": 0.01, "duration": 1.0}}, "swarm.speed_rms"),  # fmt: skip
     "thermostat at 1e4 m/s": (changed(GAS, "thermostat", {"rms_velocity": 1e4}), "thermostat.rms_velocity"),
@@ -277,6 +277,12 @@ DOUBTFUL: dict[str, tuple[dict, str]] = {
     "linear start tilt 0.6 rad": (changed(FIG9, "agents.0.tilt", 0.6), "agents[0].tilt"),
     "linear tilt rate 20 rad/s": (changed(FIG9, "agents.0.tilt_rate", 20.0), "agents[0].tilt_rate"),
     "tilt limit 0.6 rad": (changed(FIG9, "interaction.c_max", 0.6), "interaction.c_max"),
+    "tilt limit 2 rad, a limit past the horizontal": (changed(FIG9, "interaction.c_max", 2.0), "interaction.c_max"),
+    "tilt limit 10 rad, never saturating": (changed(GAS, "interaction.c_max", 10.0), "interaction.c_max"),
+    "small agents passing through each other between steps": (
+        changed(changed(changed(GAS, "interaction", {"function": "repulsion", "radius": 0.05, "d_t": 0.05, "eps": 0.01}),
+                        "space", {"axes": 2, "walls": True, "box": [300.0, 300.0], "wall_radius": 39.95}),
+                "swarm", {"n": 50, "seed": 1, "speed_rms": 8.4}), "swarm.speed_rms"),
     "eps 0.03 m at dt 0.01 s": (changed(changed(FIG9, "interaction.eps", 0.03), "simulation.dt", 0.01), "interaction.eps"),
     "closing at 20 m/s": (changed(FIG9, "agents.1.velocity", 18.5), "agents[1].velocity"),
     "delay 5 s": (changed(FIG9, "sensing", {"delay": 5.0}), "sensing.delay"),

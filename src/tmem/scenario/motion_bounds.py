@@ -111,11 +111,10 @@ def _check_tilts(scenario: Scenario) -> list[Doubt]:
     model, doubts = scenario.model, []
     where = f"(2)'s g phi stands for g tan(phi), the horizontal acceleration with the height held, which it is off by more than {SMALL_ANGLE_ERROR:.0%} beyond {SMALL_ANGLE_TILT:.4g} rad"  # fmt: skip
     c_max = scenario.interaction.c_max
-    if c_max >= math.pi / 2:
-        raise FieldError("interaction.c_max", f"{c_max:g} rad tilts the thrust past the horizontal: the small-angle "
-                         "model (1)-(2) holds for tilts within +-pi/2 = 1.571 rad only (g phi and g tan(phi) agree in sign)")  # fmt: skip
-    if c_max > SMALL_ANGLE_TILT:
-        doubts.append(Doubt("interaction.c_max", f"{c_max:g} rad: {where}"))
+    if c_max > SMALL_ANGLE_TILT:  # a limit, not a tilt: only the tilts the law commands near it leave (2)
+        past = ", past the horizontal at +-pi/2 = 1.571 rad," if c_max >= math.pi / 2 else ""
+        doubts.append(Doubt("interaction.c_max", f"{c_max:g} rad lets the law command tilts{past} where (2) no longer "
+                            f"holds: {where}"))  # fmt: skip
     for k, tilts, rates in _start_tilts(scenario):
         start, peak = max(abs(t) for t in tilts), _peak(model, tilts, rates)
         for name, tilt in (("tilt", start), ("tilt_rate", peak)):
@@ -166,10 +165,16 @@ def _check_speeds(scenario: Scenario) -> list[Doubt]:
     if v == 0.0:
         return []
     ia, dt, doubts = scenario.interaction, scenario.simulation.dt, []
-    if v * dt >= ia.reach:
+    walled = scenario.space.walls or bool(scenario.obstacles)
+    farthest = max(ia.reach, scenario.wall_reach) if walled else ia.reach  # the farthest anything acts on an agent
+    said = f"R + R_j = {ia.reach:g} m" + (f" and R + R_w = {scenario.wall_reach:g} m" if walled else "")
+    if v * dt >= farthest:
         raise FieldError(field, f"{what} {v:.4g} m/s, {v * dt:.4g} m in one step of dt = {dt:g} s: not less than "
-                         f"R + R_j = {ia.reach:g} m, they may pass through each other between two steps "
-                         f"(at most {ia.reach / dt:.4g} m/s)")  # fmt: skip
+                         f"{said}, the farthest anything acts on an agent; between two steps they may pass "
+                         f"through all of it (at most {farthest / dt:.4g} m/s)")  # fmt: skip
+    if v * dt >= ia.reach:
+        doubts.append(Doubt(field, f"{what} {v:.4g} m/s, {v * dt:.4g} m in one step of dt = {dt:g} s: not less than "
+                            f"R + R_j = {ia.reach:g} m, they may pass through each other between two steps"))  # fmt: skip
     stop = stopping_speed(scenario.model.g, ia.c_max, ia.reach)
     if v > stop:
         doubts.append(Doubt(field, f"{what} {v:.4g} m/s, more than the {stop:.4g} m/s their tilt limits stop within "
