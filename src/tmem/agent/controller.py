@@ -18,11 +18,20 @@ copies step alike.  A controller is an object rather than a pair of pure
 functions because that state is a handful of arrays the compiled update
 changes in place, as the engine's step does, with no allocation per update;
 a flight-stack node holds the object and calls it from its timer.
+
+A controller never returns a set-point that is not finite.  A message holding a number that is
+not finite, in its stamp or its vectors, is refused: it counts as not received (as a message
+older than ``max_age`` does: a formation neighbour not heard from pushes nothing at that update),
+the controller's :attr:`~AgentController.refused` counts it, and a :class:`MessageWarning` says so
+(Python shows it once for each sender and what was wrong).  Should the law still give a
+set-point that is not finite (numbers so large that their squares overflow), the controller
+holds its last finite one and says so the same way.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterable, Sequence
 from numbers import Real
 
@@ -40,6 +49,10 @@ from tmem.agent.settings import ControllerError, ControllerSettings, Edge, Opera
 
 #: Where the number of events logged in an update is kept (:class:`tmem.engine.records.Counters`).
 _N_EVENTS = 3
+
+
+class MessageWarning(UserWarning):
+    """A message a controller refused, or a set-point it held, and why, in one line."""
 
 
 class AgentController:
@@ -87,6 +100,9 @@ class AgentController:
     events : list of Event
         What happened, as :class:`tmem.Event`: the commands it carried out, and its edges'
         couplings and uncouplings (agents named by id, the lower first).
+    refused : int
+        The messages refused since the start (or :meth:`reset`): those holding a number that is
+        not finite, counted as not received (module text).
     """
 
     def __init__(self, agent: int, gains, *, dt: float, axes: int = 1, law: ControllerLaw | dict | None = None,
@@ -156,6 +172,8 @@ class AgentController:
                 self._direction[e] = [b if low else -b for b in edge.direction]
         self._next_command = 0
         self.events: list[Event] = []
+        self.refused = 0
+        self._held = np.zeros(s.axes)  # the last finite set-point, held should the law give none
 
     @property
     def agent(self) -> int:
@@ -218,6 +236,11 @@ class AgentController:
                 self._counts, self._box, self._out)  # fmt: skip
         if self._counts[_N_EVENTS]:
             self.events += read_events(self._events, int(self._counts[_N_EVENTS]), self._ids, self.settings.dt)
+        if not np.isfinite(self._out).all():
+            warnings.warn(f"update: the law gave the set-point {self._out.tolist()} at t = {t:g} s; the last finite "
+                          f"one, {self._held.tolist()}, is held", MessageWarning, stacklevel=2)  # fmt: skip
+            return self._held.copy()
+        self._held[:] = self._out
         return self._out.copy()
 
     def _own(self, own_state) -> np.ndarray:
@@ -238,6 +261,21 @@ class AgentController:
             self.events.append(Event(time=round(k * self.settings.dt, 12), kind="command", agents=named, action=COMMANDS[kind]))
             self._next_command += 1
 
+    def _usable(self, message: AgentMessage) -> bool:
+        """Whether every number of ``message`` is finite; if not, it is refused: counted and warned of."""
+        stamp = message.stamp
+        if not (isinstance(stamp, Real) and not isinstance(stamp, bool)):
+            raise ControllerError(f"messages: the stamp of agent {message.sender}'s message must be a number (s), got {stamp!r}")
+        vectors = np.asarray(message.vectors, dtype=float)
+        finite = np.isfinite(vectors)
+        if math.isfinite(stamp) and finite.all():
+            return True
+        what = f"the stamp {stamp!r}" if not math.isfinite(stamp) else f"{vectors[~finite][0]!r} in its vectors"
+        self.refused += 1
+        warnings.warn(f"messages: agent {message.sender}'s message holds {what}; refused, as not received",
+                      MessageWarning, stacklevel=4)  # fmt: skip
+        return False
+
     def _read(self, messages: Iterable[AgentMessage], t: float) -> np.ndarray:
         """The formation neighbours' messages into the inbox (``_heard``: which came); ``P*`` of the
         other flying senders, in the order their pushes are added.  Of several messages from one
@@ -249,7 +287,7 @@ class AgentController:
         try:
             for m in messages:
                 sender = m.sender
-                if sender == me or (max_age is not None and t - m.stamp > max_age):
+                if sender == me or not self._usable(m) or (max_age is not None and t - m.stamp > max_age):
                     continue
                 row = rows.get(sender)
                 if row is None:
@@ -262,6 +300,8 @@ class AgentController:
             table = np.empty((len(ranked), self.settings.axes))
             for q, (_, sender) in enumerate(ranked):
                 table[q] = others[sender].vectors[0]
+        except ControllerError:
+            raise
         except ValueError:
             raise ControllerError(f"messages: the message of agent {sender} is not of {self.settings.axes} axes") from None
         return table

@@ -17,6 +17,7 @@ or grounded at the start, and swarms of more than :data:`MAX_AGENTS`.
 
 from __future__ import annotations
 
+import os
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -28,7 +29,7 @@ from tmem.law.record import law_of
 from tmem.engine.trajectory import Event
 from tmem.world.initial import build
 from tmem.vehicles import vehicle_model
-from tmem.scenario import Scenario
+from tmem.scenario import Scenario, as_scenario
 from tmem.agent.controller import AgentController
 from tmem.law.params import ControllerLaw, LawParams
 from tmem.agent.settings import ControllerError, Edge, OperatorCommand
@@ -71,7 +72,7 @@ def _refusal(scenario: Scenario) -> tuple[str, str] | None:
     return None
 
 
-def controllers_for(scenario: Scenario) -> list[AgentController]:
+def controllers_for(scenario: Scenario | str | os.PathLike | dict) -> list[AgentController]:
     """One controller per agent of ``scenario``, in the order of its agents.
 
     Each has the scenario's gains (:meth:`tmem.vehicles.base.VehicleModel.gains`) and law
@@ -81,14 +82,18 @@ def controllers_for(scenario: Scenario) -> list[AgentController]:
 
     Parameters
     ----------
-    scenario : Scenario
-        A validated scenario.
+    scenario : Scenario, str, os.PathLike or dict
+        A validated scenario, the path of a scenario file or a dict of its tables
+        (:func:`tmem.scenario.as_scenario`).
 
     Raises
     ------
     ControllerError
         What the scenario asks that per-agent controllers do not do, in one line naming the field.
+    ScenarioError
+        A file or tables refused, or a ``scenario`` of another type, in one line.
     """
+    scenario = as_scenario(scenario)
     _refuse_what_is_not_flown(scenario)
     c, ia, sim = scenario.controller, scenario.interaction, scenario.simulation
     model = vehicle_model(scenario.model)
@@ -169,7 +174,7 @@ def _step_events(controllers: Sequence[AgentController], seen: Sequence[int]) ->
     return [event for event, times in commands.items() for _ in range(times)] + pairs
 
 
-def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None) -> Flight:
+def fly(scenario: Scenario | str | os.PathLike | dict, controllers: Sequence[AgentController] | None = None) -> Flight:
     """Fly ``scenario`` with one controller per agent (:func:`controllers_for`), in a plain loop.
 
     At each step ``k`` (time ``k dt``) every agent makes its message, every controller reads all
@@ -179,8 +184,9 @@ def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None
 
     Parameters
     ----------
-    scenario : Scenario
-        A validated scenario that per-agent controllers can fly.
+    scenario : Scenario, str, os.PathLike or dict
+        A validated scenario that per-agent controllers can fly, its file or its tables
+        (:func:`tmem.scenario.as_scenario`).
     controllers : sequence of AgentController or None
         One per agent, in the order of the agents (they are reset first); ``None``:
         :func:`controllers_for` the scenario.
@@ -190,7 +196,10 @@ def fly(scenario: Scenario, controllers: Sequence[AgentController] | None = None
     ControllerError
         As :func:`controllers_for`, where ``controllers`` do not fit the scenario, or where the
         scenario has sensing effects (the per-agent loop passes every message exactly).
+    ScenarioError
+        A file or tables refused, or a ``scenario`` of another type, in one line.
     """
+    scenario = as_scenario(scenario)
     controllers = _controllers_to_fly(scenario, controllers)
     sim = scenario.simulation
     model = vehicle_model(scenario.model, scenario.wind)

@@ -14,6 +14,7 @@ agents.
 
 from __future__ import annotations
 
+import os
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -26,8 +27,9 @@ from tmem.world.initial import InitialArrays, build
 from tmem.vehicles import vehicle_model
 from tmem.world.neighbors import spatial_order
 from tmem.scenario import Scenario
-from tmem.scenario.sensing_table import SensingParams
-from tmem.world.sensing import exact, sensing_of
+from tmem.scenario.files import as_scenario
+from tmem.scenario.sensing_table import SensingParams, with_overrides
+from tmem.world.sensing import Sensing, exact, sensing_of
 from tmem.engine.checkpoint import Checkpoints, Saved, restore
 from tmem.engine.loop import advance_for
 from tmem.engine.variants import Variant
@@ -165,7 +167,7 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
 
 
 def simulate(
-    scenario: Scenario,
+    scenario: Scenario | str | os.PathLike | dict,
     progress: Callable[[int, int], None] | None = None,
     chunk_seconds: float = 0.1,
     record: bool = True,
@@ -177,7 +179,8 @@ def simulate(
     Parameters
     ----------
     scenario
-        A validated scenario.
+        A validated scenario, the path of a scenario file (:func:`tmem.scenario.load`) or a dict of
+        its tables (:func:`tmem.scenario.from_dict`).
     progress
         Called as ``progress(steps_done, steps_total)`` between chunks of the
         compiled loop; chunks last about ``chunk_seconds``.
@@ -186,9 +189,10 @@ def simulate(
     record
         ``False`` records nothing but the end state (for benchmarks).
     sensing
-        Fields of the measurement stage's record (:class:`tmem.world.sensing.Sensing`) set over the ones of
-        the scenario's ``[sensing]`` table, for effects the table does not name; given, even empty,
-        the run takes the sensed path.  By default the table decides: without effects, every agent
+        Keys of the ``[sensing]`` table, set in the scenario over its own and checked as the table
+        is, and fields of the measurement stage's record (:class:`tmem.world.sensing.Sensing`) that
+        no key sets, for effects the table does not name (finite numbers); given, even empty, the
+        run takes the sensed path.  By default the table decides: without effects, every agent
         knows every state exactly.
     checkpoints
         Save the run's state at these checkpoints (:mod:`tmem.engine.checkpoint`), and go on from
@@ -200,11 +204,15 @@ def simulate(
 
     Raises
     ------
+    ScenarioError
+        If the scenario, its file or an override of the sensing is refused (one line naming it).
     SimulationError
         If the run diverged.
     CheckpointError
         If the checkpoint file is not one this run made.
     """
+    scenario = as_scenario(scenario)
+    scenario, sensing = with_overrides(scenario, sensing, Sensing._fields)
     resume = checkpoints.start(scenario, record, sensing) if checkpoints is not None else None
     sim, c = scenario.simulation, scenario.controller
     model = vehicle_model(scenario.model, scenario.wind)

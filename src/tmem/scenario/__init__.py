@@ -4,7 +4,8 @@ A scenario is a TOML file with the tables ``[model]`` (Table 1), ``[controller]`
 (roots (5)), ``[interaction]``, ``[simulation]``, ``[[agents]]`` (Table 2) and
 ``[[commands]]``.  Every key is checked: unknown keys, non-finite numbers and
 values out of range are refused with :class:`ScenarioError`, a one-line
-message naming the field and the reason.  Defaults are documented in
+message naming the field and the reason; physical values beyond what the model makes meaningful
+are refused the same way, and values legal but doubtful warned of (:class:`ScenarioWarning`).  Defaults are documented in
 ``docs/parameters.md``.
 
 * :mod:`~tmem.scenario.tables` — the tables' base class and number types; the model, controller,
@@ -17,6 +18,10 @@ message naming the field and the reason.  Defaults are documented in
 * :mod:`~tmem.scenario.budget` — the memory a run needs and the size of its records;
 * :mod:`~tmem.scenario.sensing_table` — the ``[sensing]`` table and its checks against the scenario;
 * :mod:`~tmem.scenario.wind_table` — the ``[wind]`` table (the quadrotor's wind) and its checks;
+* :mod:`~tmem.scenario.bounds` — the physical bounds' figures, each from the model, and
+  :class:`ScenarioWarning`, the warning of a doubtful value;
+* :mod:`~tmem.scenario.vehicle_bounds` — the quadrotor's and its wind's bounds;
+* :mod:`~tmem.scenario.motion_bounds` — the bounds of the starts, the formation and the sensing;
 * :mod:`~tmem.scenario.files` — reading, writing and editing files; the presets.
 """
 
@@ -48,6 +53,7 @@ _EXPORTS = {
     "QuadrotorModelParams": "tables",
     "Scenario": "schema",
     "ScenarioError": "tables",
+    "ScenarioWarning": "bounds",
     "SensingParams": "sensing_table",
     "SimulationParams": "tables",
     "SpaceParams": "space_table",
@@ -58,6 +64,7 @@ _EXPORTS = {
     "TurbulenceParams": "wind_table",
     "Vector": "agents_table",
     "WindParams": "wind_table",
+    "as_scenario": "files",
     "describe": "files",
     "from_dict": "files",
     "load": "files",
@@ -105,6 +112,7 @@ __all__ = [
     "QuadrotorModelParams",
     "Scenario",
     "ScenarioError",
+    "ScenarioWarning",
     "SensingParams",
     "SimulationParams",
     "SpaceParams",
@@ -114,6 +122,7 @@ __all__ = [
     "TurbulenceParams",
     "Vector",
     "WindParams",
+    "as_scenario",
     "describe",
     "from_dict",
     "load",

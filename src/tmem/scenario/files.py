@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import stat
 import tomllib
 import typing
@@ -20,6 +21,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from tmem.scenario import crazyflies
+from tmem.scenario.bounds import reading
 from tmem.scenario.schema import Scenario
 from tmem.scenario.tables import MODEL_KINDS, FieldError, ScenarioError
 
@@ -195,9 +197,36 @@ def loads(text: str, source: str = "<scenario>", directory: Path | None = None) 
             f"{source}: is a sweep file (it has {', '.join(sweep_keys)}), not a scenario; run it with tmem sweep"
         )
     try:
-        return from_dict(crazyflies.expand(data, directory or Path.cwd()))
+        with reading(source):
+            return from_dict(crazyflies.expand(data, directory or Path.cwd()))
     except ScenarioError as exc:
         raise ScenarioError(f"{source}: {exc}") from None
+
+
+def as_scenario(value: Scenario | str | os.PathLike | dict, argument: str = "scenario") -> Scenario:
+    """A validated scenario from what a caller passed: a :class:`Scenario`, the path of a scenario
+    file (:func:`load`) or a dict of its tables (:func:`from_dict`).
+
+    Parameters
+    ----------
+    value : Scenario, str, os.PathLike or dict
+        The scenario, its file or its tables.
+    argument : str
+        The caller's name for it, at the start of the message of anything else.
+
+    Raises
+    ------
+    ScenarioError
+        One line: the file's or the tables' first fault, or ``argument`` of another type.
+    """
+    if isinstance(value, Scenario):
+        return value
+    if isinstance(value, str | os.PathLike):
+        return load(value)
+    if isinstance(value, dict):
+        return from_dict(value)
+    raise ScenarioError(f"{argument}: must be a Scenario, the path of a scenario file or a dict of its tables, "
+                        f"got {type(value).__name__}")  # fmt: skip
 
 
 def _optional_table(table: type[BaseModel] | None, key: str) -> type[BaseModel] | None:

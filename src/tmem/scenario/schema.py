@@ -21,13 +21,16 @@ import numpy as np
 from pydantic import create_model, field_validator, model_validator
 
 from tmem.analysis.coverage import MAX_CELLS
+from tmem.analysis.coverage.grid import finest_cell
 from tmem.terms import TERMS, term_class
 from tmem.world.formation import generate
 from tmem.law.interaction.registry import uses_coupling
 from tmem.scenario.agents_table import Agent, SwarmParams, check_agents
+from tmem.scenario.bounds import warn
 from tmem.scenario.budget import check_memory, check_record_size, memory_limit
 from tmem.scenario.commands_table import Command, check_commands
 from tmem.scenario.formation_table import FormationParams, check_formation
+from tmem.scenario.motion_bounds import check_motion
 from tmem.scenario.sensing_table import SensingParams, check_sensing
 from tmem.scenario.space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
 from tmem.scenario.tables import (
@@ -41,6 +44,7 @@ from tmem.scenario.tables import (
     StrictModel,
     per_axis,
 )
+from tmem.scenario.vehicle_bounds import check_vehicle
 from tmem.scenario.wind_table import WindParams, check_wind
 
 #: Beyond this many agents, a coupling function needs a [formation]: without one every pair
@@ -114,9 +118,14 @@ class _Scenario(StrictModel):
 
     @property
     def coverage_cell(self) -> float:
-        """Side of the coverage map's cells (m): ``coverage.cell``, default ``R``."""
+        """Side of the coverage map's cells (m): ``coverage.cell``; by default ``R``, or, in a box that
+        cells of side ``R`` would cut into more than :data:`~tmem.analysis.coverage.grid.DEFAULT_CELLS`,
+        the smallest side that cuts it into that many at most
+        (:func:`~tmem.analysis.coverage.grid.finest_cell`)."""
         cell = self.coverage.cell if self.coverage is not None else None
-        return self.interaction.radius if cell is None else cell
+        if cell is not None:
+            return cell
+        return finest_cell(self.space.box[:2], self.interaction.radius) if self.space.box else self.interaction.radius
 
     @property
     def agent_terms(self) -> tuple[str, ...]:
@@ -210,6 +219,8 @@ class _Scenario(StrictModel):
                 table.check(self)
         check_record_size(self, n, len(pairs))
         self._check_formation_room(axes, n)
+        doubts = check_vehicle(self) + check_motion(self)  # the physical bounds (docs/parameters.md, "Bounds")
+        warn(doubts)  # only once every check has passed: a refused scenario warns of nothing
         return self
 
     def _check_formation_room(self, axes: int, n: int) -> None:

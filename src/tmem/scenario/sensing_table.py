@@ -152,3 +152,55 @@ def check_sensing(scenario: Scenario, n_agents: int, uses_lists: bool, limit: in
         field = "sensing.hold" if sensing.loss > 0.0 and lag(sensing.hold, dt) > lag(sensing.delays[1], dt) else "sensing.delay"
         raise FieldError(field, f"keeps {sensing.depth(dt)} steps of past messages of {n_agents} agents, about "
                          f"{kept / 2**30:.3g} GiB (at most {limit / 2**30:.3g} GiB); shorten it or take a larger dt")  # fmt: skip
+
+
+#: The measurement stage's fields (:class:`tmem.world.sensing.Sensing`) that the ``[sensing]`` table
+#: and the run set: an override names the table's key instead.
+DERIVED_FIELDS = ("agent", "every", "lag_min", "lag_max", "delay_min", "delay_max", "dt", "range2", "history", "own",
+                  "pair_states", "pushes", "work")  # fmt: skip
+
+
+def with_overrides(scenario: Scenario, overrides: dict | None, fields: tuple[str, ...]) -> tuple[Scenario, dict | None]:
+    """The scenario with the overrides of its ``[sensing]`` table's keys set, validated as the table
+    is, and the other overrides, checked: ``(scenario, rest)``.
+
+    ``tmem.simulate(scenario, sensing={...})`` takes, over the table, the table's keys and the
+    fields of the measurement stage that no key sets (an added effect's); a key of the table goes
+    into the scenario, whose every check it then meets (``{"loss": 2.0}`` is refused as
+    ``loss = 2.0`` in the file is).  ``rest`` is ``None`` where ``overrides`` is.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario, validated.
+    overrides : dict or None
+        The overrides, by name.
+    fields : tuple of str
+        The measurement stage's fields (``Sensing._fields``).
+
+    Raises
+    ------
+    ScenarioError
+        One line naming the override at fault (``sensing.loss: must be less than 1, got 2.0``).
+    """
+    from tmem.scenario.files import with_changes  # the files module imports the schema, which imports this one
+    from tmem.scenario.tables import ScenarioError
+
+    if overrides is None:
+        return scenario, None
+    if not isinstance(overrides, dict):
+        raise ScenarioError(f"sensing: must be a dict of the [sensing] table's keys, got {type(overrides).__name__}")
+    keys = {k: v for k, v in overrides.items() if k in SensingParams.model_fields}
+    rest = {k: v for k, v in overrides.items() if k not in keys}
+    for key, value in rest.items():
+        if key in DERIVED_FIELDS:
+            raise ScenarioError(f"sensing.{key}: is set from the [sensing] table's keys and the run; give those "
+                                f"({', '.join(SensingParams.model_fields)})")  # fmt: skip
+        if key not in fields:
+            raise ScenarioError(f"sensing.{key}: unknown key (a typo?); the [sensing] table's keys are "
+                                f"{', '.join(SensingParams.model_fields)}")  # fmt: skip
+        if isinstance(value, int | float) and not isinstance(value, bool) and not math.isfinite(value):
+            raise ScenarioError(f"sensing.{key}: must be a finite number, got {value!r}")
+    if keys:
+        scenario = with_changes(scenario, {f"sensing.{k}": v for k, v in keys.items()})
+    return scenario, rest

@@ -21,8 +21,9 @@ Only the quadrotor model feels wind: it acts through the drag, and the linear mo
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from tmem.scenario.tables import FieldError, Number, NonNegative, Positive, StrictModel, per_axis
@@ -35,6 +36,47 @@ LOWEST, HIGHEST = 3.048, 304.8
 #: The strongest wind a scenario may set (m/s): beyond any a multirotor flies in, and above the strongest
 #: surface gust measured (113 m/s, Barrow Island, 1996).  A larger figure is a slip of units.
 STRONGEST = 100.0
+#: One foot and one knot in SI units (m, m/s).
+FOOT = 0.3048
+KNOT = 1852.0 / 3600.0
+#: ``W_20``, the wind speed at 20 ft, of each severity of MIL-F-8785C's low-altitude turbulence (m/s).
+SEVERITY_W20 = {"light": 15.0 * KNOT, "moderate": 30.0 * KNOT, "severe": 45.0 * KNOT}
+
+
+def low_altitude_scales(height: float, w20: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma, L)`` of ``(u, v, w)``, (D4)-(D5) of :mod:`tmem.vehicles.wind`: MIL-F-8785C's
+    low-altitude intensities and scales.
+
+    Parameters
+    ----------
+    height : float
+        Height above the ground (m), from 10 to 1000 ft (3.048 to 304.8 m).
+    w20 : float
+        The wind speed at 20 ft, 6 m (m/s).
+    """
+    h = height / FOOT
+    base = 0.177 + 0.000823 * h
+    sigma_w = 0.1 * w20
+    sigma_u = sigma_w / base**0.4
+    length_u = h / base**1.2 * FOOT
+    return np.array([sigma_u, sigma_u, sigma_w]), np.array([length_u, length_u, height])
+
+
+def scales(turbulence: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma, L)`` of ``(u, v, w)`` for a ``[wind.turbulence]`` table: given, or (D4)-(D5).
+
+    Parameters
+    ----------
+    turbulence : TurbulenceParams
+        The table.
+    """
+    w20 = turbulence.w20 if turbulence.w20 is not None else SEVERITY_W20.get(turbulence.severity, 0.0)
+    sigma, length = low_altitude_scales(turbulence.height, w20)
+    if turbulence.sigma is not None:
+        sigma = np.array(turbulence.sigma, dtype=float)
+    if turbulence.length is not None:
+        length = np.array(turbulence.length, dtype=float)
+    return sigma, length
 
 
 class TurbulenceParams(StrictModel):

@@ -65,6 +65,16 @@ class GroundRobotParams(StrictModel):
         """
         return im_r**2
 
+    def largest_acceleration(self, c_max: float) -> float:
+        """The largest acceleration (m/s^2) the law asks for: ``c_max``, within what the drive gives.
+
+        Parameters
+        ----------
+        c_max : float
+            The law's limit (m/s^2).
+        """
+        return min(c_max, self.a_max)
+
     def check(self, scenario) -> None:
         """The law asks at most what the drive gives (``interaction.c_max <= a_max``), and the agents
         start with their drive at rest (no tilt: the robot has none).

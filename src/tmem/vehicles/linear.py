@@ -19,6 +19,8 @@ sampling the control.
 
 from __future__ import annotations
 
+import math
+
 from functools import cache
 from typing import ClassVar, Literal, NamedTuple
 
@@ -121,6 +123,17 @@ class TiltingGain:
             The roots (5) (1/s).
         """
         return (r_l**2 + im_l**2) * im_r**2 / (self.g * self.kp * self.kd)
+
+    def largest_acceleration(self, c_max: float) -> float:
+        """The largest horizontal acceleration (m/s^2) the law asks for: ``g tan(c_max)``, the tilt limit
+        held with the height held (the first order of (2)'s ``g c_max``).
+
+        Parameters
+        ----------
+        c_max : float
+            The tilt limit (rad).
+        """
+        return self.g * math.tan(min(c_max, math.pi / 2 - 1e-9))
 
 
 class LinearModelParams(TiltingGain, StrictModel):

@@ -38,6 +38,7 @@ import numba
 import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
+from tmem.scenario.bounds import substeps as count_substeps
 from tmem.vehicles.base import VehicleModel
 from tmem.vehicles.quadrotor_table import QuadrotorModelParams
 from tmem.vehicles.flight_controller import (REFERENCE_FIELDS, REFERENCE_LONG_NAMES, REFERENCE_NAMES, REFERENCE_UNITS, acceleration_loop,
@@ -321,7 +322,7 @@ class QuadrotorModel(VehicleModel):
             The time step (s).
         """
         p = self.params
-        substeps = max(1, math.ceil(dt / p.inner_period - 1e-9))
+        substeps = count_substeps(dt, p.inner_period)
         acceleration = p.inner_loop == "acceleration"
         return QuadrotorStep(*self.airframe(), p.kp, p.kd, p.altitude_kp, p.altitude_kd, p.drag_feedforward and not acceleration,
                              substeps, dt / substeps, acceleration, *reference_hold(p.kp, p.kd, dt / substeps),
@@ -339,7 +340,19 @@ class QuadrotorModel(VehicleModel):
         Parameters
         ----------
         state : ndarray, shape (agents, axes, 4)
+
+        Raises
+        ------
+        ValueError
+            Where a tilt is not within +-pi/2 (a tilt of the thrust axis along an axis,
+            ``atan2(b_3a, b_3z)``, lies there), in one line naming the agent and the axis.
         """
+        tilts = np.asarray(state)[:, :, 2]
+        outside = ~(np.abs(tilts) < 0.5 * math.pi)  # NaN too
+        if outside.any():
+            i, a = (int(k) for k in np.argwhere(outside)[0])
+            raise ValueError(f"state: the tilt of agent {i} on axis {a} is {tilts[i, a]!r} rad; a tilt of the thrust "
+                             "axis along an axis, atan2(b_3a, b_3z), lies within +-pi/2 = 1.571 rad")  # fmt: skip
         frame = self.airframe()
         body = np.zeros((state.shape[0], len(self.body_names)))
         for i, agent in enumerate(state):

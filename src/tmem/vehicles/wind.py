@@ -69,12 +69,9 @@ import numpy as np
 
 from tmem import _numba_cache  # noqa: F401  (drops stale compiled code before any is loaded)
 from tmem.world.streams import message_key, normal_pair
+# The intensities and scales (D4)-(D5) are the [wind] table's, read by validation without Numba.
+from tmem.scenario.wind_table import FOOT, KNOT, SEVERITY_W20, low_altitude_scales, scales  # noqa: F401
 
-#: One foot and one knot in SI units (m, m/s).
-FOOT = 0.3048
-KNOT = 1852.0 / 3600.0
-#: ``W_20``, the wind speed at 20 ft, of each severity of MIL-F-8785C's low-altitude turbulence (m/s).
-SEVERITY_W20 = {"light": 15.0 * KNOT, "moderate": 30.0 * KNOT, "severe": 45.0 * KNOT}
 #: The "sender" of the wind's draws in :func:`tmem.world.streams.message_key`: no agent's number.
 WIND_STREAM = np.uint64(0xFFFFFFFFFFFFFFFF)
 
@@ -95,24 +92,6 @@ PER_COMPONENT = 10
 #: in a record).
 WIND_FIELDS = [("wind_x", float), ("wind_y", float), ("wind_z", float), ("along_x", float), ("along_y", float),
                ("turbulent", bool), ("seed", int), ("gust", np.ndarray)]  # fmt: skip
-
-
-def low_altitude_scales(height: float, w20: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(sigma, L)`` of ``(u, v, w)``, (D4)-(D5): MIL-F-8785C's low-altitude intensities and scales.
-
-    Parameters
-    ----------
-    height : float
-        Height above the ground (m), from 10 to 1000 ft (3.048 to 304.8 m).
-    w20 : float
-        The wind speed at 20 ft, 6 m (m/s).
-    """
-    h = height / FOOT
-    base = 0.177 + 0.000823 * h
-    sigma_w = 0.1 * w20
-    sigma_u = sigma_w / base**0.4
-    length_u = h / base**1.2 * FOOT
-    return np.array([sigma_u, sigma_u, sigma_w]), np.array([length_u, length_u, height])
 
 
 def dryden_psd(omega: np.ndarray, sigma: np.ndarray, length: np.ndarray, speed: float) -> np.ndarray:
@@ -217,23 +196,6 @@ def initial_gusts(wind: Any, n_agents: int) -> np.ndarray:
         gusts[i, :5] = first_gusts(c, seed, i)
         gusts[i, 5] = i
     return gusts
-
-
-def scales(turbulence: Any) -> tuple[np.ndarray, np.ndarray]:
-    """``(sigma, L)`` of ``(u, v, w)`` for a ``[wind.turbulence]`` table: given, or (D4)-(D5).
-
-    Parameters
-    ----------
-    turbulence : TurbulenceParams
-        The table (:class:`tmem.scenario.wind_table.TurbulenceParams`).
-    """
-    w20 = turbulence.w20 if turbulence.w20 is not None else SEVERITY_W20.get(turbulence.severity, 0.0)
-    sigma, length = low_altitude_scales(turbulence.height, w20)
-    if turbulence.sigma is not None:
-        sigma = np.array(turbulence.sigma, dtype=float)
-    if turbulence.length is not None:
-        length = np.array(turbulence.length, dtype=float)
-    return sigma, length
 
 
 @numba.njit(cache=True, inline="always")

@@ -12,6 +12,9 @@ import numpy as np
 
 #: Most cells a grid may have (its first-visit map alone takes 8 bytes a cell).
 MAX_CELLS = 50_000_000
+#: Most cells of a map whose cell is not given (``[coverage] cell``): more than the 720 x 600 pixels
+#: of ``field.png`` (6 x 5 in at 120 dpi), so that a finer map would show nothing more.
+DEFAULT_CELLS = 1_000_000
 
 Obstacle = tuple[Sequence[float], float]
 
@@ -54,6 +57,29 @@ def check_sizes(box, cell, sensor_radius, axes: int) -> tuple[np.ndarray, float,
     if not (math.isfinite(sensor_radius) and sensor_radius >= 0):
         raise ValueError(f"sensor_radius: must be finite and not negative, got {sensor_radius!r}")
     return sides, cell, sensor_radius
+
+
+def finest_cell(sides, cell: float, most: int = DEFAULT_CELLS) -> float:
+    """``cell``, or, where it would cut the sides into more than ``most`` cells, the smallest cell
+    side (m) that cuts them into at most that many.
+
+    Parameters
+    ----------
+    sides : sequence of float
+        The sides of the covered axes (m): a walled box's first two at most.
+    cell : float
+        The cell side wanted (m).
+    most : int
+        The most cells (:data:`DEFAULT_CELLS`, for a map whose cell is not given).
+    """
+    sides = [float(s) for s in sides]
+    count = lambda c: math.prod(math.ceil(s / c) for s in sides)  # noqa: E731 (the schema's count, unrounded)
+    if count(cell) <= most:
+        return cell
+    coarser = (math.prod(sides) / most) ** (1.0 / len(sides))
+    while count(coarser) > most:  # the ceilings add a part of a cell per axis: a step or two
+        coarser *= 1.0 + 1e-6
+    return coarser
 
 
 def check_obstacles(obstacles, dims: int) -> list[tuple[np.ndarray, float]]:

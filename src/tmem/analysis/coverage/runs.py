@@ -4,17 +4,15 @@
 
 from __future__ import annotations
 
-import math
-
-from tmem.analysis.coverage.grid import MAX_CELLS
 from tmem.analysis.coverage.metric import Coverage, coverage
 
 
 def run_coverage(trajectory) -> Coverage | None:
     """The coverage of a run's walled box (:func:`~tmem.analysis.coverage.metric.coverage` on its recorded
     agents), with the cell and sensor radius of its ``[coverage]`` table (default: cells of side
-    ``R``, sensor radius 0); ``None`` when the run has no walled box, recorded nothing, or its box
-    would need more than :data:`~tmem.analysis.coverage.grid.MAX_CELLS` cells of side ``R``.
+    ``R``, coarser where ``R`` would cut the box into more than
+    :data:`~tmem.analysis.coverage.grid.DEFAULT_CELLS` cells: :attr:`tmem.scenario.Scenario.coverage_cell`;
+    sensor radius 0); ``None`` when the run has no walled box or recorded nothing.
 
     Parameters
     ----------
@@ -26,8 +24,6 @@ def run_coverage(trajectory) -> Coverage | None:
         return None
     settings = scenario.coverage
     cell = scenario.coverage_cell
-    if math.prod(math.ceil(side / cell) for side in scenario.space.box[:2]) > MAX_CELLS:
-        return None  # a field too fine to map by default (a [coverage] table this fine is refused)
     radius = 0.0 if settings is None else settings.sensor_radius
     obstacles = [(o.center[:2], o.radius) for o in scenario.obstacles]
     return coverage(trajectory.state[..., 0], trajectory.time, trajectory.active, scenario.space.box, cell,
