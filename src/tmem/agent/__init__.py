@@ -28,9 +28,10 @@ paper's equations and the conditions of the bit-identity.
 
 from __future__ import annotations
 
-from tmem.agent.controller import AgentController
+from tmem.agent.controller import AgentController, MessageWarning
 from tmem.agent.messages import AgentMessage
 from tmem.agent.settings import ControllerError, Edge, OperatorCommand
 from tmem.agent.swarm import Flight, controllers_for, fly
 
-__all__ = ["AgentController", "AgentMessage", "ControllerError", "Edge", "Flight", "OperatorCommand", "controllers_for", "fly"]
+__all__ = ["AgentController", "AgentMessage", "ControllerError", "Edge", "Flight", "MessageWarning", "OperatorCommand", "controllers_for",
+           "fly"]
