@@ -328,3 +328,18 @@ def test_just_inside_a_bound_is_accepted_without_a_word(name):
 
 def test_the_battery_has_forty_new_cases_and_more():
     assert len(REFUSED) + len(DOUBTFUL) + len(ACCEPTED) >= 40
+
+
+def test_the_command_warns_of_a_doubtful_value_in_one_line(tmp_path):
+    """``tmem run`` prints a doubt as one ``warning:`` line on standard error, as it prints an error."""
+    import subprocess
+    import sys
+
+    scenario = tmp_path / "w.toml"
+    scenario.write_text('[interaction]\nc_max = 0.6\n[simulation]\nduration = 1.0\n[[agents]]\nposition = 50.0\n'
+                        '[[agents]]\nposition = 0.0\n')  # fmt: skip
+    done = subprocess.run([sys.executable, "-m", "tmem", "run", str(scenario), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    warned = [line for line in done.stderr.splitlines() if line.strip()]
+    assert warned == [warned[0]] and warned[0].startswith("warning: interaction.c_max: 0.6 rad lets the law command tilts")

@@ -338,8 +338,12 @@ def view_command(
 
 def main() -> None:
     """Entry point of the ``tmem`` console script."""
+    import warnings
+
+    from tmem.cli.messages import show_warning
     from tmem.files.outputs import handle_termination, ignore_interrupts
 
+    warnings.showwarning = show_warning  # a doubtful value is one line, "warning: ...", as an error is
     handle_termination()  # SIGTERM and SIGHUP as Ctrl-C: interrupted writes leave nothing behind
     try:
         app()

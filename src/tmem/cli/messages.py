@@ -28,7 +28,22 @@ except ImportError:  # pragma: no cover - an earlier Typer
 #: ``tmem`` alone shows its help: click says so by this error (click 8.2 and later).
 _NO_ARGS = getattr(_errors, "NoArgsIsHelpError", ())
 
-__all__ = ["Commands", "error_line", "usage_line"]
+__all__ = ["Commands", "error_line", "show_warning", "usage_line"]
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print a warning as the one line ``warning: ...`` on standard error (a doubtful value's, say,
+    :class:`tmem.scenario.ScenarioWarning`), escaped as an error is; :func:`warnings.showwarning`'s
+    signature, so that the ``tmem`` command installs it in its place.
+
+    Parameters
+    ----------
+    message : Warning or str
+        The warning.
+    category, filename, lineno, file, line
+        As :func:`warnings.showwarning` takes them; only ``message`` is shown.
+    """
+    print(f"warning: {one_line(str(message))}", file=sys.stderr)
 
 
 def error_line(message: str) -> str:
