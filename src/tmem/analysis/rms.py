@@ -16,13 +16,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:  # the command line reads SWINGS and swings() from here, without the engine
+if TYPE_CHECKING:
     from tmem.engine import Trajectory
 
-__all__ = ["SWINGS", "rms_velocity", "rms_over_time", "rms_peak", "rms_summary", "swings"]
+__all__ = ["rms_velocity", "rms_over_time", "rms_peak", "rms_summary"]
 
-#: What a reader of ΔRMS is told when it swings (:func:`swings`): the printed table and the viewer say it.
-SWINGS = "pairs still coupled and oscillating at the end: ΔRMS is an instantaneous value that swings with their oscillation"
 
 
 def rms_velocity(velocity: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
@@ -129,18 +127,3 @@ def rms_summary(trajectory: Trajectory, pairs_coupled_at_end: int, settled: bool
         "rms_change_peak_percent": peak,
         "rms_change_peak_time": at,
     }
-
-
-def swings(summary: dict) -> bool:
-    """Whether a summary's ``rms_change_percent`` swings with an oscillation still going on at the end.
-
-    A summary written before ``rms_change_swings`` existed counts every run that ends with pairs
-    coupled as swinging.
-
-    Parameters
-    ----------
-    summary : dict
-        ``summary.json`` as read (:func:`tmem.analysis.metrics.summarize`).
-    """
-    swinging = summary.get("rms_change_swings", summary.get("rms_change_while_coupled"))
-    return bool(swinging) and summary.get("rms_change_percent") is not None

@@ -13,8 +13,8 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Column, Table
 from rich.text import Text
 
-from tmem.analysis.rms import SWINGS as swinging_note
-from tmem.analysis.rms import swings
+from tmem.analysis.caveats import SWINGS as swinging_note
+from tmem.analysis.caveats import swings
 
 #: Runs expected to take less than this (s) show no progress bar.
 PROGRESS_AFTER = 1.0

@@ -20,7 +20,7 @@ from importlib import resources
 import numpy as np
 
 from tmem import __version__
-from tmem.analysis.rms import SWINGS, swings
+from tmem.analysis.caveats import SWINGS, swings
 from tmem.figures.viewer.data import View
 
 #: The mark of a file written by ``tmem view`` (in the page's first line of comment).
@@ -83,7 +83,7 @@ def _number(value, form: str, unit: str = "") -> str:
 def headline(summary: dict) -> list[tuple[str, str]]:
     """The figures of ``summary.json`` shown above the view, as (label, text); "—" for one missing.
 
-    ΔRMS, from the start to the end, is marked ``*`` where it swings (:func:`tmem.analysis.rms.swings`,
+    ΔRMS, from the start to the end, is marked ``*`` where it swings (:func:`tmem.analysis.caveats.swings`,
     explained by :func:`caveat`); "largest ΔRMS" is the change from the start with the largest
     magnitude on the way, and when (``rms_change_peak_percent``, ``rms_change_peak_time``).
 
@@ -108,7 +108,7 @@ def headline(summary: dict) -> list[tuple[str, str]]:
 
 
 def caveat(summary: dict) -> str:
-    """What the page says under its headline of a ΔRMS that swings (:data:`tmem.analysis.rms.SWINGS`,
+    """What the page says under its headline of a ΔRMS that swings (:data:`tmem.analysis.caveats.SWINGS`,
     as the printed table says it); empty when it does not.
 
     Parameters

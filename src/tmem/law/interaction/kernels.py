@@ -190,24 +190,36 @@ def improved_switching(r, f_en, p):
     return _saturate(u, p.c_max)
 
 
+#: The docstring of :func:`pair_control` and of each branch it is composed of.
+_DISPATCH_DOC = """``U`` of the function with the integer code ``function`` (its registry row) for one pair.
+
+Parameters
+----------
+function : int
+    The registry code (:func:`tmem.law.interaction.registry.code`).
+r, f_en, p
+    As the kernels take them: ``|d|`` (m), ``F_en``, :class:`FunctionParams`.
+"""
+
+
 def _dispatch(rows) -> object:
     """:func:`pair_control` over the registry's ``rows``: the first row's kernel where ``function`` is
     its code, else the dispatch over the rest (the last row's kernel where no code matched)."""
     kernel, number = globals()[rows[0].kernel], code(rows[0].name)
     if len(rows) == 1:
         @numba.njit(inline="always")
-        def last(function, r, f_en, p):
+        def dispatch(function, r, f_en, p):
             return kernel(r, f_en, p)
+    else:
+        rest = _dispatch(rows[1:])
 
-        return last
-    rest = _dispatch(rows[1:])
+        @numba.njit(inline="always")
+        def dispatch(function, r, f_en, p):
+            if function == number:
+                return kernel(r, f_en, p)
+            return rest(function, r, f_en, p)
 
-    @numba.njit(inline="always")
-    def dispatch(function, r, f_en, p):
-        if function == number:
-            return kernel(r, f_en, p)
-        return rest(function, r, f_en, p)
-
+    dispatch.__doc__ = _DISPATCH_DOC
     return dispatch
 
 
