@@ -71,8 +71,6 @@ SCALAR_METRICS = (
     "rms_velocity_initial",
     "rms_velocity_final",
     "rms_change_percent",
-    "rms_change_peak_percent",
-    "rms_change_peak_time",
     "min_distance",
     "final_distance",
     "coupled",
