@@ -147,15 +147,10 @@ def _in_slots(scenario: Scenario, initial: InitialArrays, gains: np.ndarray, rec
     slot[order] = np.arange(n_agents)
     x = initial.state[order]
     body = body[order]
-    agents = Agents(x, x.copy(), initial.active[order], np.empty((n_agents, n_axes, 2)), np.zeros((n_agents, n_axes)),
-                    body, body.copy())
+    agents = Agents.at_start(x, initial.active[order], body)
     edges = initial.edges
     n_edges = len(edges)
-    pairs = Pairs(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy(),
-                  np.ones(n_edges, dtype=np.int64), np.full(n_edges, np.nan), np.full(n_edges, np.inf),
-                  np.full(n_edges, np.nan), np.full(n_edges, np.nan), np.full(n_edges, np.nan),
-                  np.full(n_edges, np.nan), np.zeros(n_edges, dtype=np.int64),
-                  np.empty(n_axes))  # fmt: skip
+    pairs = Pairs.at_start(slot[edges[:, 0]], slot[edges[:, 1]], initial.d_t, initial.direction, initial.flag.copy())
     commands = _commands(scenario, edges, slot)
     steps = record_steps(sim.n_steps, sim.record_every) if record else np.empty(0, dtype=np.int64)
     recorded = np.arange(n_agents) if sim.record_agents is None else np.array(sim.record_agents, dtype=np.int64)

@@ -76,6 +76,21 @@ class Agents(NamedTuple):
     body: np.ndarray
     body_start: np.ndarray
 
+    @classmethod
+    def at_start(cls, state: np.ndarray, active: np.ndarray, body: np.ndarray) -> "Agents":
+        """The agents at the start of a run: these states, flying flags and body states (each also kept
+        as where an added agent starts), nothing pushed yet.
+
+        Parameters
+        ----------
+        state : ndarray, shape (agents, axes, n_state)
+        active : ndarray, shape (agents,), bool
+        body : ndarray, shape (agents, n_body)
+        """
+        n_agents, n_axes = state.shape[:2]
+        return cls(state=state, start=state.copy(), active=active, corrected=np.empty((n_agents, n_axes, 2)),
+                   setpoint=np.zeros((n_agents, n_axes)), body=body, body_start=body.copy())  # fmt: skip
+
 
 class Pairs(NamedTuple):
     """The formation pairs (or every pair of a small swarm), each ``(i, j)`` with its flag.
@@ -124,6 +139,28 @@ class Pairs(NamedTuple):
     kept_speed2: np.ndarray
     disarmed_at: np.ndarray
     d: np.ndarray
+
+    @classmethod
+    def at_start(cls, i: np.ndarray, j: np.ndarray, d_t: np.ndarray, direction: np.ndarray, flag: np.ndarray) -> "Pairs":
+        """The pairs at the start of a run: armed, with nothing measured or remembered yet.
+
+        Parameters
+        ----------
+        i, j : ndarray, shape (pairs,), int
+            Slots of the two agents.
+        d_t : ndarray, shape (pairs,)
+            Set distances (m).
+        direction : ndarray, shape (pairs, axes)
+            Directions to hold (NaN rows: none).
+        flag : ndarray, shape (pairs,), int
+            ``F_en`` at the start.
+        """
+        n = len(i)
+        nothing = lambda: np.full(n, np.nan)  # noqa: E731
+        return cls(i=i, j=j, d_t=d_t, direction=direction, flag=flag, armed=np.ones(n, dtype=np.int64), r_before=nothing(),
+                   min_distance=np.full(n, np.inf), coupled_gap=nothing(), coupled_energy=nothing(),
+                   entry_speed2=nothing(), kept_speed2=nothing(), disarmed_at=np.zeros(n, dtype=np.int64),
+                   d=np.empty(direction.shape[1]))  # fmt: skip
 
 
 class Neighbours(NamedTuple):
