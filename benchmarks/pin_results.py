@@ -367,7 +367,8 @@ def compare(old: Path, new: Path, rtol: float) -> bool:
         with np.load(old / f"{name}.npz") as a, np.load(new / f"{name}.npz") as b:
             a, b = dict(a), dict(b)
         details, worst, worst_array = [], 0.0, ""
-        for key in sorted(set(a) | set(b)):
+        added = sorted(key for key in set(b) - set(a) if key.startswith("summary."))  # a figure the summary gained
+        for key in sorted((set(a) | set(b)) - set(added)):
             if key not in a or key not in b:
                 details.append(f"    {key}: missing in {old if key not in a else new}")
                 worst, worst_array = np.inf, key
@@ -379,7 +380,7 @@ def compare(old: Path, new: Path, rtol: float) -> bool:
                 if diff >= worst:
                     worst, worst_array = diff, key
         if not details:
-            print(f"{name:32} identical")
+            print(f"{name:32} identical" + (f" (and the summary's new {', '.join(added)})" if added else ""))
             continue
         print(f"{name:32} max relative difference {worst:.3g} ({worst_array})")
         print("\n".join(details))
