@@ -181,7 +181,7 @@ def test_the_command_line_warns_of_a_doubtful_value_in_one_line(tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1, done.stderr
-    assert lines[0].startswith(f"{path}:0: ScenarioWarning: interaction.eps: 0.003 m is less than the 0.0045 m"), lines[0]
+    assert lines[0].startswith("warning: interaction.eps: 0.003 m is less than the 0.0045 m"), lines[0]
 
 
 def test_a_walled_box_of_small_agents_maps_its_coverage(tmp_path):
