@@ -249,6 +249,37 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     assert gif.exists() and partials(tmp_path, "run.gif") == []
 
 
+def test_an_interrupt_a_library_turns_into_its_own_error_still_ends_the_command_as_interrupted(
+    run_2d, tmp_path, monkeypatch, capfd
+):
+    """Ctrl-C while Matplotlib's compiled code calls back into Python: the KeyboardInterrupt raised
+    there comes out as Matplotlib's ValueError ("Invalid affine transformation matrix"). The command
+    still ends as interrupted, status 130, not as a failed one with that error."""
+    import tmem.figures.animate
+    import tmem.files.outputs.signals as signals
+    from tmem.cli.main import main
+
+    def drawn_as_matplotlib_may(*args, **kwargs):
+        try:
+            signal.raise_signal(signal.SIGINT)
+        except KeyboardInterrupt:
+            raise ValueError("Invalid affine transformation matrix") from None
+
+    monkeypatch.setattr(tmem.figures.animate, "animate", drawn_as_matplotlib_may)
+    monkeypatch.setattr(signals, "_received", [])
+    monkeypatch.setattr(sys, "argv", ["tmem", "animate", str(run_2d)])
+    handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        with pytest.raises(SystemExit) as ended:
+            main()
+    finally:
+        for signum, handler in handlers.items():  # main() leaves them ignored, as the process ends there
+            signal.signal(signum, handler)
+    output = capfd.readouterr()
+    assert ended.value.code == 130, output
+    assert "affine" not in output.out + output.err and "error" not in output.out + output.err
+
+
 # --- tmem plot
 
 

@@ -45,7 +45,15 @@ def _options(
     """Run a scenario, reproduce the paper, animate or plot a run, sweep many."""
 
 def _fail(message: str | Exception) -> None:
-    """Say ``message`` as one line on standard error (:func:`tmem.cli.messages.error_line`) and exit with status 2."""
+    """Say ``message`` as one line on standard error (:func:`tmem.cli.messages.error_line`) and exit with status 2.
+
+    An error raised while a signal was being handled is the signal's: the command ends as interrupted
+    (:func:`tmem.files.outputs.signals.interrupted`).
+    """
+    from tmem.files.outputs.signals import interrupted
+
+    if interrupted():
+        raise KeyboardInterrupt
     if isinstance(message, OSError) and message.filename and message.strerror:
         message = f"{message.filename}: {message.strerror}"
     console.print(f"[bold red]error:[/] {escape(error_line(str(message)))}", highlight=False, soft_wrap=True)

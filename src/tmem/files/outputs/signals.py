@@ -8,19 +8,35 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 
+_received: list[int] = []
+
+
 def _raise_interrupt(signum: int, frame) -> None:
+    _received.append(signum)
     raise KeyboardInterrupt
 
 
+def interrupted() -> bool:
+    """Whether Ctrl-C, SIGTERM or SIGHUP has come since :func:`handle_termination`.
+
+    A library's compiled code that calls back into Python may turn the
+    :class:`KeyboardInterrupt` raised there into an error of its own
+    (Matplotlib: "Invalid affine transformation matrix"); a command that
+    fails asks this first, and ends as interrupted rather than failed.
+    """
+    return bool(_received)
+
+
 def handle_termination() -> None:
-    """Handle SIGTERM (and SIGHUP) as Ctrl-C: raise :class:`KeyboardInterrupt` in the main thread.
+    """Handle Ctrl-C, SIGTERM and SIGHUP alike: raise :class:`KeyboardInterrupt` in the main thread, and
+    remember that one came (:func:`interrupted`).
 
     A signal the parent process set to be ignored (``nohup``) stays ignored.
     Called by the ``tmem`` command before it runs; only the main thread can.
     """
     if threading.current_thread() is not threading.main_thread():
         return
-    for name in ("SIGTERM", "SIGHUP"):
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         signum = getattr(signal, name, None)
         if signum is not None and signal.getsignal(signum) is not signal.SIG_IGN:
             signal.signal(signum, _raise_interrupt)
