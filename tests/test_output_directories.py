@@ -301,6 +301,22 @@ def test_run_removes_what_a_killed_run_left_and_nothing_else(runner, tmp_path):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out.tmem-partial-") and p not in kept]
 
 
+def test_animate_removes_what_a_writer_killed_while_making_its_temporary_directory_left(runner, tmp_path, pair_2d):
+    """Killed between making ``.NAME.tmem-starting-…`` and renaming it: its lock file holds its process
+    id, locked by nobody, so it is removed; one whose lock file is still empty is being locked this
+    instant by a live writer, and is kept."""
+    out = tmp_path / "pair"
+    assert invoke(runner, "run", pair_2d, "--out", out)[0] == 0
+    gone = tmp_path / f".pair.gif.tmem-starting-{dead_pid()}-0123abcd"
+    being_made = tmp_path / f".pair.gif.tmem-starting-{dead_pid()}-0123abce"
+    for path, text in ((gone, json.dumps({"pid": 1})), (being_made, "")):
+        path.mkdir()
+        (path / WRITING).write_text(text)
+    code, stderr, _ = invoke(runner, "animate", out, "--max-frames", "3")
+    assert code == 0, stderr
+    assert not gone.exists() and (being_made / WRITING).is_file() and (tmp_path / "pair.gif").exists()
+
+
 def test_a_writer_in_another_pid_namespace_is_left_to_write(runner, tmp_path):
     """Its process id means nothing here (a container, `unshare --pid`): its lock says it writes."""
     foreign = dead_pid()  # no such process in this namespace

@@ -7,10 +7,12 @@ inside it (:data:`WRITING`): the lock ends with the process, however it ends, an
 every process that opens the file, whichever process-id namespace (container, ``unshare --pid``)
 or machine sharing the folder it runs in.  A temporary directory whose lock can be taken was left
 by a writer that is gone (:func:`is_leftover`) and is removed by the next command writing into the
-same folder (:func:`remove_leftovers`).  The process id in the name is for people: it is never
-used to decide.  Anything else is left alone: a name that does not match exactly, a directory
-without the lock file (an earlier tmem's, or one being made), one whose lock is held, and every
-temporary name on a file system that has no locks.
+same folder (:func:`remove_leftovers`); so is the directory a writer killed while it made one left,
+``.NAME.tmem-starting-PID-RANDOM``, once its lock file holds what the writer writes there after
+locking it.  The process id in the name is for people: it is never used to decide.  Anything else
+is left alone: a name that does not match exactly, a directory without the lock file (an earlier
+tmem's, or one being made), one whose lock file is still empty (being locked this instant), one
+whose lock is held, and every temporary name on a file system that has no locks.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from pathlib import Path
 _NAME_KEPT = 180
 #: The longest name of a file or folder (bytes) on common file systems.
 _NAME_MAX = 255
-_PARTIAL = re.compile(r"\.(?P<name>.*)\.tmem-partial-(?P<pid>[0-9]{1,10})-(?P<tag>[0-9a-f]{8})(?:\.[A-Za-z0-9]{1,10})?", re.S)
+_PARTIAL = re.compile(r"\.(?P<name>.*)\.tmem-(?:partial|starting)-(?P<pid>[0-9]{1,10})-(?P<tag>[0-9a-f]{8})(?:\.[A-Za-z0-9]{1,10})?", re.S)
 #: The lock file inside a temporary directory: its writer holds ``flock`` on it while it writes.
 WRITING = ".tmem-writing"
 
@@ -142,7 +144,8 @@ def discard(directory: Path, fd: int) -> None:
 
 
 def is_partial(path: Path) -> bool:
-    """Whether ``path``'s name is a temporary name of tmem's (:func:`partial_name`).
+    """Whether ``path``'s name is a temporary name of tmem's (:func:`partial_name`, or
+    :func:`make_partial`'s name while it makes one).
 
     Parameters
     ----------
@@ -159,7 +162,8 @@ def is_leftover(path: Path) -> bool:
     ----------
     path : Path
         The entry to judge: its name must be a temporary name, and it must hold the lock file
-        :data:`WRITING`, which this process can lock (and at once lets go).
+        :data:`WRITING`, not empty (its writer writes into it only once it holds the lock), which
+        this process can lock (and at once lets go).
     """
     if not is_partial(path):
         return False
@@ -175,7 +179,7 @@ def is_leftover(path: Path) -> bool:
     if fd < 0:
         return False
     try:
-        return _lock(fd, block=False)
+        return os.fstat(fd).st_size > 0 and _lock(fd, block=False)
     finally:
         os.close(fd)
 
