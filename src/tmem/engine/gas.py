@@ -95,11 +95,8 @@ def gas_agent(i, known, agents, params, gas, box, counting, first):
     corrected, setpoint = agents.corrected, agents.setpoint
     wall_params = with_reach(params, gas.wall_reach)  # the repulsion (8), with R + R_w
     n_axes = len(box)
-    walls = gas.walls
-    obstacles = gas.obstacles
-    work = gas.work
-    limit = gas.limit
-    pushed = gas.pushed
+    walls, obstacles, pushed = gas.walls, gas.obstacles, gas.pushed  # the box's walls and obstacles, their pushes
+    work, limit = gas.work, gas.limit
     bounded = obstacles.shape[0] > 0
     for a in range(n_axes):
         bounded = bounded or walls[a] > 0.0
