@@ -1,7 +1,9 @@
 """Submodules loaded on first use: ``tmem.law.interaction`` works after ``import tmem`` alone.
 
 Each package of :mod:`tmem` sets ``__getattr__ = submodules(__name__)`` (PEP 562), so that reading a
-submodule as an attribute imports it, and importing the package imports nothing heavy.
+submodule as an attribute imports it, and importing the package imports nothing heavy.  The
+registries (:data:`tmem.vehicles.VEHICLES`, :data:`tmem.terms.TERMS`) name their classes as
+``"module:name"`` strings, imported when a run needs them (:func:`import_named`).
 """
 
 from __future__ import annotations
@@ -25,3 +27,15 @@ def submodules(package: str):
         raise AttributeError(f"module {package!r} has no attribute {name!r}")
 
     return __getattr__
+
+
+def import_named(path: str) -> object:
+    """The object ``path = "module:name"`` names, its module imported now (a registry's row).
+
+    Parameters
+    ----------
+    path : str
+        ``"module:name"``, e.g. ``"tmem.terms.pull:Pull"``.
+    """
+    module, name = path.split(":")
+    return getattr(import_module(module), name)

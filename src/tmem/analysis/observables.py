@@ -69,7 +69,7 @@ def wall_area(trajectory: Trajectory) -> float | None:
     Parameters
     ----------
     trajectory : Trajectory
-        A run (:func:`tmem.simulate`).
+        A run (:func:`tmem.simulate`) in a walled box, or in any other space (``None``).
     """
     space = trajectory.scenario.space
     if not space.walls:

@@ -66,6 +66,16 @@ def _say(text: str) -> None:
     Console().print(one_line(text), markup=False, highlight=False, soft_wrap=True)
 
 
+def _say_written(write, *args, **kwargs) -> None:
+    """Write one file, ``write(*args, **kwargs)`` returning its path, and say ``written PATH``; a
+    :class:`ValueError` or :class:`OSError` ends the command in one line (:func:`_fail`)."""
+    try:
+        path = write(*args, **kwargs)
+    except (ValueError, OSError) as exc:
+        _fail(exc)
+    _say(f"written {path}")
+
+
 def _resuming(time: float) -> None:
     console.print(f"going on from the checkpoint at t = {time:g} s", highlight=False, soft_wrap=True)
 
@@ -184,11 +194,7 @@ def animate_command(
             _fail(f"{option}: must be at least 1, got {value}")
     from tmem.figures.animate import animate
 
-    try:
-        path = animate(run_dir, out, fps=fps, max_frames=max_frames)
-    except (ValueError, OSError) as exc:
-        _fail(exc)
-    _say(f"written {path}")
+    _say_written(animate, run_dir, out, fps=fps, max_frames=max_frames)
 
 
 @app.command("plot")
@@ -238,7 +244,7 @@ def export_command(
     Parameters
     ----------
     run_dir : Path
-        A run directory written by ``tmem run``.
+        The run to export: a directory written by ``tmem run``.
     to : str
         ``mcap`` or ``csv`` (``docs/exchange.md``).
     out : Path or None
@@ -246,11 +252,7 @@ def export_command(
     """
     from tmem.files.exchange import export
 
-    try:
-        path = export(run_dir, to, out)
-    except (ValueError, OSError) as exc:
-        _fail(exc)
-    _say(f"written {path}")
+    _say_written(export, run_dir, to, out)
 
 
 @app.command("sweep")
@@ -337,11 +339,7 @@ def view_command(
             _fail(f"{option}: must be at least 1, got {value}")
     from tmem.figures.viewer import MAX_AGENTS, write_view
 
-    try:
-        path = write_view(run_dir, out, max_agents=max_agents or MAX_AGENTS, max_frames=max_frames)
-    except (ValueError, OSError) as exc:
-        _fail(exc)
-    _say(f"written {path}")
+    _say_written(write_view, run_dir, out, max_agents=max_agents or MAX_AGENTS, max_frames=max_frames)
 
 
 def main() -> None:

@@ -196,7 +196,7 @@ def restore(saved: Saved, state: dict) -> None:
     Parameters
     ----------
     saved : Saved
-        The checkpoint (:meth:`Checkpoints.start`).
+        The checkpoint the run goes on from (:meth:`Checkpoints.start`).
     state : dict
         The run's :data:`CHANGING` records, by name, as built for its start.
 

@@ -23,6 +23,11 @@ are taken every ``simulation.gas_period`` (a *count*, ``Gas.every`` steps apart)
 is held between counts: the weights of the mean of pushes, the thermostat's group pushes.  The
 walls, the thermostat's free part and the momentum the walls take act at every step.  The running
 totals (per agent, summed at each record) are those of :data:`TOTALS`.
+
+The gas's per-agent functions, here, in :mod:`tmem.engine.gas_counts` and in
+:mod:`tmem.engine.thermostat`, take agent ``i``'s slot, ``known``, the states as measured (shape
+(agents, axes, n_state): the true ones, since the gas's stages run only where sensing is exact),
+and the number of axes ``n_axes``.
 """
 
 from __future__ import annotations
@@ -74,10 +79,8 @@ def gas_agent(i, known, agents, params, gas, box, counting, first):
 
     Parameters
     ----------
-    i : int
-        The agent's slot.
-    known : ndarray, shape (agents, axes, n_state)
-        The states as measured.
+    i, known
+        As every per-agent function of the gas takes them (module text).
     agents, gas
         The loop's records (:mod:`tmem.engine.records`); ``agents.setpoint`` and ``gas`` change in place.
     params : FunctionParams
@@ -92,11 +95,8 @@ def gas_agent(i, known, agents, params, gas, box, counting, first):
     corrected, setpoint = agents.corrected, agents.setpoint
     wall_params = with_reach(params, gas.wall_reach)  # the repulsion (8), with R + R_w
     n_axes = len(box)
-    walls = gas.walls
-    obstacles = gas.obstacles
-    work = gas.work
-    limit = gas.limit
-    pushed = gas.pushed
+    walls, obstacles, pushed = gas.walls, gas.obstacles, gas.pushed  # the box's walls and obstacles, their pushes
+    work, limit = gas.work, gas.limit
     bounded = obstacles.shape[0] > 0
     for a in range(n_axes):
         bounded = bounded or walls[a] > 0.0

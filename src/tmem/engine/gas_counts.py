@@ -36,14 +36,10 @@ def clear(i, known, work, n_axes):
 
     Parameters
     ----------
-    i : int
-        The agent's slot.
-    known : ndarray, shape (agents, axes, n_state)
-        The states as measured.
+    i, known, n_axes
+        As every per-agent function of the gas takes them (:mod:`tmem.engine.gas`).
     work : ndarray
         ``Gas.work`` (:class:`tmem.engine.records.Gas`), changed in place.
-    n_axes : int
-        Number of axes.
     """
     speed2 = 0.0
     for a in range(n_axes):

@@ -52,12 +52,8 @@ def _advance_source(k_stop, run, law, params, vehicle, knowledge, agents, pairs,
     box = run.box
     n_axes = len(box)
     c_max = params.c_max
-    x = agents.state
-    u = agents.setpoint
-    body = agents.body
-    active = agents.active
-    block_ptr = neighbours.block_ptr
-    block_nearest2 = neighbours.block_nearest2
+    x, u, body, active = agents.state, agents.setpoint, agents.body, agents.active
+    block_ptr, block_nearest2 = neighbours.block_ptr, neighbours.block_nearest2  # the blocks of neighbour pairs
     n_blocks = block_ptr.shape[0] - 1
     for k in range(counters.step[0], k_stop):
         counters.step[0] = k

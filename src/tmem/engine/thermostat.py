@@ -58,10 +58,8 @@ def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
 
     Parameters
     ----------
-    i : int
-        The agent's slot.
-    known : ndarray, shape (agents, axes, n_state)
-        The states as known.
+    i, known, n_axes
+        As every per-agent function of the gas takes them (:mod:`tmem.engine.gas`).
     work, held : ndarray
         ``Gas.work``, with the count's sums, and ``Gas.held``, changed in place
         (:mod:`tmem.engine.gas_counts`).
@@ -71,8 +69,6 @@ def hold_group_push(i, known, work, held, rate, target2, inv_g, n_axes):
         ``T*`` (m^2/s^2).
     inv_g : float
         ``1 / g``: an acceleration as a tilt.
-    n_axes : int
-        Number of axes.
     """
     contact = work[i, CONTACT]
     together = min(1.0, contact / FULL_CONTACT)
@@ -99,22 +95,18 @@ def add_thermostat_push(i, known, setpoint, held, limit, rate, target2, inv_g, c
 
     Parameters
     ----------
-    i : int
-        The agent's slot.
-    known : ndarray, shape (agents, axes, n_state)
-        The states as known.
+    i, known, n_axes
+        As every per-agent function of the gas takes them (:mod:`tmem.engine.gas`).
     setpoint : ndarray, shape (agents, axes)
         The pushes summed, changed in place.
     held : ndarray
         ``Gas.held``: the group's push.
     limit : ndarray, shape (agents,)
         ``Gas.limit``: the agent's tilt limit this step, written.
-    rate, target2, inv_g : float
-        ``1 / (2 tau)`` (1/s), ``T*`` (m^2/s^2) and ``1 / g``.
+    rate, target2, inv_g
+        As :func:`hold_group_push` takes them.
     c_max : float
         The scenario's tilt limit (rad).
-    n_axes : int
-        Number of axes.
     """
     speed2 = 0.0
     for a in range(n_axes):

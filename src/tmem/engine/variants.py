@@ -63,8 +63,8 @@ class Variant:
 
         Parameters
         ----------
-        stage : str
-            The template's name (``advance``, ``agent_block``).
+        stage : {"advance", "agent_block", "agent_stage"}
+            The template's name.
         """
         parts = (stage, self.vehicle, self.knowledge, *self.terms, *(("gas",) if self.gas else ()),
                  "threaded" if self.threaded else "serial")  # fmt: skip

@@ -58,6 +58,24 @@ def _mark_events(ax, trajectory: Trajectory) -> None:
         seen.add(e.kind)
 
 
+def _time_figure():
+    """A figure of one plot against time, ``(fig, ax)``, as the velocity, formation and gas figures draw."""
+    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    return fig, fig.subplots()
+
+
+def _finish_time_plot(ax, trajectory: Trajectory, ylabel: str, title: str, legend: bool = True) -> None:
+    """The run's events marked on ``ax``, its axes labelled (time along x), ``title`` above it, a grid
+    and, if ``legend``, the legend of its lines."""
+    _mark_events(ax, trajectory)
+    ax.set_xlabel("time, s")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, parse_math=False)
+    ax.grid(alpha=0.3)
+    if legend:
+        ax.legend(loc="best", fontsize=8)
+
+
 def velocity_figure(trajectory: Trajectory):
     """Each agent's velocity (speed, on several axes) and the RMS velocity against time.
 
@@ -69,8 +87,7 @@ def velocity_figure(trajectory: Trajectory):
     trajectory : Trajectory
         A run (:func:`tmem.simulate`).
     """
-    fig = Figure(figsize=(8, 4.5), layout="constrained")
-    ax = fig.subplots()
+    fig, ax = _time_figure()
     t = trajectory.time
     velocity = trajectory.model.velocity(trajectory.state)
     one_axis = velocity.shape[2] == 1
@@ -81,11 +98,8 @@ def velocity_figure(trajectory: Trajectory):
         ax.plot(t, value, color=color, linewidth=1.2 if mappable is None else 0.8, label=agent_label(trajectory.agents[q]))
     rms = metrics.rms_velocity(velocity, trajectory.active)
     ax.plot(t, rms, color="k", linestyle="--", linewidth=1.5, label="RMS velocity, every recorded agent")
-    _mark_events(ax, trajectory)
-    ax.set_xlabel("time, s")
-    ax.set_ylabel("velocity V, m/s" if one_axis else "speed |V|, m/s")
-    ax.set_title(run_title(trajectory, chosen.note), parse_math=False)
-    ax.grid(alpha=0.3)
+    ylabel = "velocity V, m/s" if one_axis else "speed |V|, m/s"
+    _finish_time_plot(ax, trajectory, ylabel, run_title(trajectory, chosen.note), legend=False)
     agents_legend(ax, mappable)
     return fig
 
@@ -150,8 +164,7 @@ def formation_figure(trajectory: Trajectory):
     trajectory : Trajectory
         A run (:func:`tmem.simulate`).
     """
-    fig = Figure(figsize=(8, 4.5), layout="constrained")
-    ax = fig.subplots()
+    fig, ax = _time_figure()
     coupled = trajectory.flag == 1
     error = np.where(coupled, np.abs(trajectory.pair_distance - trajectory.d_t), 0.0)
     count = coupled.sum(axis=1)
@@ -160,12 +173,8 @@ def formation_figure(trajectory: Trajectory):
     ax.plot(t, error[some].max(axis=1), color="tab:red", linewidth=1.2, label="largest")
     ax.plot(t, np.sqrt((error[some] ** 2).sum(axis=1) / count[some]), color="k", linewidth=1.5, label="RMS")
     ax.plot(t, error[some].sum(axis=1) / count[some], color="tab:blue", linewidth=1.2, label="mean")
-    _mark_events(ax, trajectory)
-    ax.set_xlabel("time, s")
-    ax.set_ylabel("| distance - d_t |, m (coupled pairs)")
-    ax.set_title(run_title(trajectory, f"over all {len(trajectory.pairs)} pairs of the formation, while coupled"), parse_math=False)
-    ax.grid(alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    title = run_title(trajectory, f"over all {len(trajectory.pairs)} pairs of the formation, while coupled")
+    _finish_time_plot(ax, trajectory, "| distance - d_t |, m (coupled pairs)", title)
     return fig
 
 
@@ -177,8 +186,7 @@ def gas_figure(trajectory: Trajectory):
     trajectory : Trajectory
         A run that observed its gas.
     """
-    fig = Figure(figsize=(8, 4.5), layout="constrained")
-    ax = fig.subplots()
+    fig, ax = _time_figure()
     ax.plot(trajectory.time, temperature(trajectory), color="k", linewidth=1.5, label="RMS velocity, all agents")
     scenario = trajectory.scenario
     settings = [(0.0, scenario.thermostat.rms_velocity if scenario.thermostat else None)]
@@ -188,12 +196,7 @@ def gas_figure(trajectory: Trajectory):
         times = [t for t, _ in steps]
         values = [v for _, v in steps[:-1]] + [steps[-2][1]]
         ax.step(times, values, where="post", color="tab:red", linestyle="--", label="set-point")
-    _mark_events(ax, trajectory)
-    ax.set_xlabel("time, s")
-    ax.set_ylabel("RMS velocity, m/s")
-    ax.set_title(run_title(trajectory), parse_math=False)
-    ax.grid(alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    _finish_time_plot(ax, trajectory, "RMS velocity, m/s", run_title(trajectory))
     return fig
 
 

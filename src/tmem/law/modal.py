@@ -123,14 +123,13 @@ def printed_gains(kp: float, kd: float, g: float, r_l: float, im_l: float, im_r:
 
     Parameters
     ----------
-    kp, kd, g
-        The model's parameters (1)-(2), Table 1.
-    r_l, im_l, im_r
-        The roots (5), Table 1.
+    kp, kd, g, r_l, im_l, im_r
+        As :func:`modal_gains` takes them: the model's parameters (1)-(2) and the roots (5).
 
     Returns
     -------
     ndarray, shape (4,)
+        The printed ``K`` (its real part), its first two entries swapped as said above.
     """
     p1, p2, p3, p4 = roots(r_l, im_l, im_r)
     beta = 1.0 / (kp * kd)

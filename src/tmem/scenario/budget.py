@@ -66,10 +66,8 @@ def check_memory(scenario: Scenario, n: int, pairs: int) -> None:
 
     Parameters
     ----------
-    scenario : Scenario
-        The scenario, its tables valid on their own.
-    n : int
-        Its number of agents.
+    scenario, n
+        The scenario, its tables valid on their own, and its number of agents.
     pairs : int
         How many pairs it tracks, at most.
     """
@@ -96,12 +94,8 @@ def check_record_size(scenario: Scenario, n: int, pairs: int) -> None:
 
     Parameters
     ----------
-    scenario : Scenario
-        The scenario, its tables valid on their own.
-    n : int
-        Its number of agents.
-    pairs : int
-        The number of pairs it tracks.
+    scenario, n, pairs
+        As :func:`check_memory` takes them, ``pairs`` now the number of pairs the run tracks.
     """
     size = record_bytes(scenario.simulation, scenario.space.axes, n, pairs)
     if size > MAX_RECORD_BYTES:

@@ -71,10 +71,8 @@ def check_commands(scenario: Scenario, n: int, formation_pairs: np.ndarray) -> N
 
     Parameters
     ----------
-    scenario : Scenario
-        The scenario, its tables valid on their own.
-    n : int
-        Its number of agents.
+    scenario, n
+        The scenario, its tables valid on their own, and its number of agents.
     formation_pairs : ndarray, shape (m, 2)
         The pairs a couple / uncouple command may name (:meth:`Scenario.pairs`).
     """

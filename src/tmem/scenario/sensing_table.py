@@ -126,10 +126,8 @@ def check_sensing(scenario: Scenario, n_agents: int, uses_lists: bool, limit: in
 
     Parameters
     ----------
-    scenario : Scenario
-        The scenario, its tables valid on their own.
-    n_agents : int
-        Its number of agents.
+    scenario, n_agents
+        The scenario, its tables valid on their own, and its number of agents.
     uses_lists : bool
         Whether the run finds neighbours with lists (:meth:`NeighborParams.uses_lists`).
     limit : int

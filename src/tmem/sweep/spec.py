@@ -339,10 +339,8 @@ def loads_sweep(text: str, source: str = "<sweep>", directory: Path | None = Non
 
     Parameters
     ----------
-    text : str
-        The sweep, in TOML.
-    source : str
-        Where the text came from, at the start of an error message.
+    text, source : str
+        The sweep, in TOML, and where it came from, as :func:`tmem.scenario.loads` takes a scenario's.
     directory : Path or None
         Where a relative ``base`` file is found; default: the current directory.
     """

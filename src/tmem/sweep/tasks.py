@@ -167,12 +167,8 @@ def run_chunk(base: Scenario, cases: list[Case], metrics: tuple[str, ...]) -> li
 
     Parameters
     ----------
-    base : Scenario
-        The sweep's base scenario.
-    cases : list of Case
-        The cases, each a set of changes to ``base``.
-    metrics : tuple of str
-        The metrics kept in each row (the sweep file's ``metrics``).
+    base, cases, metrics
+        As :func:`plan_chunks` takes them; ``cases`` one of the chunks it plans.
     """
     try:
         scenario = with_changes(base, _shared(cases[0]))

@@ -12,10 +12,9 @@ modules here import no compiler: a term's kernel is compiled when a run binds it
 
 from __future__ import annotations
 
-from tmem._lazy import submodules
+from tmem._lazy import import_named, submodules
 
 from functools import cache
-from importlib import import_module
 
 #: The agent terms, ``scenario table -> "module:Class"``, in the order their pushes are added.
 TERMS: dict[str, str] = {
@@ -30,9 +29,8 @@ def term_class(name: str):
     Parameters
     ----------
     name : str
-        A key of :data:`TERMS`.
+        The scenario table's name, a key of :data:`TERMS`.
     """
-    module, cls = TERMS[name].split(":")
-    return getattr(import_module(module), cls)
+    return import_named(TERMS[name])
 
 __getattr__ = submodules(__name__)  # noqa: F811  (submodules loaded on first use)

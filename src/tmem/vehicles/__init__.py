@@ -16,10 +16,9 @@ compiled code.  Adding a model is one module in this package and one row here
 
 from __future__ import annotations
 
-from tmem._lazy import submodules
+from tmem._lazy import import_named, submodules
 
 from functools import cache
-from importlib import import_module
 from typing import Any
 
 #: ``kind -> ("module:Model", "module:Table")``: each vehicle model's class and its ``[model]`` table.
@@ -31,12 +30,6 @@ VEHICLES: dict[str, tuple[str, str]] = {
 }
 
 
-def _named(path: str) -> Any:
-    """The object ``"module:name"`` names, its module imported."""
-    module, name = path.split(":")
-    return getattr(import_module(module), name)
-
-
 @cache
 def vehicle_class(kind: str):
     """The :class:`~tmem.vehicles.base.VehicleModel` subclass of the ``[model] kind`` ``kind``.
@@ -46,7 +39,7 @@ def vehicle_class(kind: str):
     kind : str
         A key of :data:`VEHICLES`.
     """
-    return _named(VEHICLES[kind][0])
+    return import_named(VEHICLES[kind][0])
 
 
 @cache
@@ -56,9 +49,9 @@ def vehicle_table(kind: str):
     Parameters
     ----------
     kind : str
-        A key of :data:`VEHICLES`.
+        A key of :data:`VEHICLES`: the table is the second name of its row, the class the first.
     """
-    return _named(VEHICLES[kind][1])
+    return import_named(VEHICLES[kind][1])
 
 
 def vehicle_model(params: Any, wind: Any = None):

@@ -185,13 +185,10 @@ def derivative(s, command, frame, wind):
 
     Parameters
     ----------
-    s : tuple of 17 float
-        The body's state (module text).
+    s, frame, wind
+        As :func:`loads` takes them.
     command : tuple of 4 float
         The rotors' commanded speeds ``c_k`` (rad/s).
-    frame : Airframe
-    wind : tuple of 3 float
-        The wind (m/s, world frame).
     """
     return derivative_under(s, loads(s, frame, wind), command, frame)
 
@@ -202,13 +199,10 @@ def derivative_under(s, loaded, command, frame):
 
     Parameters
     ----------
-    s : tuple of 17 float
-        The body's state (module text).
     loaded : tuple
-        ``loads(s, frame, wind)``.
-    command : tuple of 4 float
-        The rotors' commanded speeds ``c_k`` (rad/s).
-    frame : Airframe
+        ``loads(s, frame, wind)``: the state's attitude and wrench.
+    s, command, frame
+        As :func:`derivative` takes them.
     """
     r, (fx, fy, fz, mx, my, mz, _, _, _) = loaded
     qx, qy, qz, qw = s[6], s[7], s[8], s[9]

@@ -56,7 +56,9 @@ and ``WIND_STREAM`` is no agent's, so the gusts do not depend on the slots, the 
 neighbour lists, the number of agents, nor on the sensing's draws.  The body state carries the
 agent's number and its step (``gust_stream``, ``gust_step``), so the vehicle's step needs nothing
 else, and a checkpoint keeps the gusts with the rest of the body.  An agent added back starts again
-from its start, its gusts too.
+from its start, its gusts too.  An agent's generator is ``(c, seed, agent)``, as the functions that
+draw gusts take it: the 30 numbers ``c`` of (D6) (:func:`gust_coefficients`), the turbulence's
+``seed`` and the ``agent``'s number in the scenario.
 """
 
 from __future__ import annotations
@@ -223,12 +225,8 @@ def next_gusts(z, c, seed, agent, step):
     ----------
     z : tuple of 5 float
         The gusts of step ``step - 1``.
-    c : ndarray, shape (30,)
-        :func:`gust_coefficients`.
-    seed : int
-        The turbulence's seed.
-    agent : int
-        The agent's number in the scenario.
+    c, seed, agent
+        The agent's generator (module text).
     step : int
         The step drawn (its draws are the message ``(seed, agent, WIND_STREAM, step)``).
     """
@@ -245,12 +243,8 @@ def first_gusts(c, seed, agent):
 
     Parameters
     ----------
-    c : ndarray, shape (30,)
-        :func:`gust_coefficients`.
-    seed : int
-        The turbulence's seed.
-    agent : int
-        The agent's number in the scenario.
+    c, seed, agent
+        The agent's generator (module text).
     """
     n1, n2, n3, n4, n5 = _normals(seed, agent, 0)
     v, w = PER_COMPONENT + 7, 2 * PER_COMPONENT + 7
@@ -264,12 +258,8 @@ def gust_series(c, seed, agent, n_steps):
 
     Parameters
     ----------
-    c : ndarray, shape (30,)
-        :func:`gust_coefficients`.
-    seed : int
-        The turbulence's seed.
-    agent : int
-        The agent's number in the scenario.
+    c, seed, agent
+        The agent's generator (module text).
     n_steps : int
         How many steps.
     """
@@ -312,14 +302,8 @@ def advance_gusts(body, i, first, params):
 
     Parameters
     ----------
-    body : ndarray, shape (agents, columns)
-        Body states, changed in place.
-    i : int
-        The agent's slot.
-    first : int
-        The column of ``gust_u``.
-    params : QuadrotorStep
-        Its :data:`WIND_FIELDS`.
+    body, i, first, params
+        As :func:`wind_now` takes them; ``body`` is changed in place.
     """
     b = body
     step = b[i, first + 6] + 1.0

@@ -14,6 +14,10 @@ origin, in the x-y plane) with the edges between lattice neighbours:
 * ``triangle`` — the ring of three;
 * ``hex``      — a hexagonal patch: the n points of a triangular lattice of
   spacing d_t nearest its centre, each joined to its lattice neighbours.
+
+Every generator takes the number of agents ``n`` (int), the set distance ``d_t`` of each coupled
+pair (float, m), the number of ``axes`` (1, 2 or 3: the shape lies in the x-y plane, on the x axis
+in 1-D) and ``bearing`` (bool: whether each pair also holds its direction ``P_j - P_i``).
 """
 
 from __future__ import annotations
@@ -71,14 +75,8 @@ def chain(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Formation
 
     Parameters
     ----------
-    n : int
-        Number of agents.
-    d_t : float
-        Set distance of each coupled pair (m).
-    axes : int
-        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
-    bearing : bool
-        Whether each pair also holds its direction ``P_j - P_i``.
+    n, d_t, axes, bearing
+        As every generator takes them (module text).
     """
     points = np.stack([np.arange(n) * d_t, np.zeros(n)], axis=1)
     return _with_edges(_place(points, axes), [(k, k + 1) for k in range(n - 1)], d_t, bearing)
@@ -89,14 +87,8 @@ def ring(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Formation:
 
     Parameters
     ----------
-    n : int
-        Number of agents.
-    d_t : float
-        Set distance of each coupled pair (m).
-    axes : int
-        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
-    bearing : bool
-        Whether each pair also holds its direction ``P_j - P_i``.
+    n, d_t, axes, bearing
+        As every generator takes them (module text).
     """
     if n < 3:
         raise ValueError(f"a ring needs at least 3 agents, got {n}")
@@ -111,12 +103,8 @@ def triangle(d_t: float, axes: int = 2, bearing: bool = False) -> Formation:
 
     Parameters
     ----------
-    d_t : float
-        Set distance of each coupled pair (m).
-    axes : int
-        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
-    bearing : bool
-        Whether each pair also holds its direction ``P_j - P_i``.
+    d_t, axes, bearing
+        As every generator takes them (module text); the ring's ``n`` is 3.
     """
     return ring(3, d_t, axes, bearing)
 
@@ -131,14 +119,8 @@ def hex_patch(n: int, d_t: float, axes: int = 2, bearing: bool = False) -> Forma
 
     Parameters
     ----------
-    n : int
-        Number of agents.
-    d_t : float
-        Set distance of each coupled pair (m).
-    axes : int
-        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
-    bearing : bool
-        Whether each pair also holds its direction ``P_j - P_i``.
+    n, d_t, axes, bearing
+        As every generator takes them (module text).
     """
     span = int(np.ceil(np.sqrt(n))) + 2
     a, b = (g.ravel() for g in np.meshgrid(np.arange(-span, span + 1), np.arange(-span, span + 1)))
@@ -167,14 +149,8 @@ def generate(kind: str, n: int, d_t: float, axes: int, bearing: bool = False) ->
     ----------
     kind : str
         ``"chain"``, ``"ring"``, ``"triangle"`` (``n`` ignored: 3) or ``"hex"``.
-    n : int
-        Number of agents.
-    d_t : float
-        Set distance of each coupled pair (m).
-    axes : int
-        1, 2 or 3; the shape lies in the x-y plane (on the x axis in 1-D).
-    bearing : bool
-        Whether each pair also holds its direction ``P_j - P_i``.
+    n, d_t, axes, bearing
+        As every generator takes them (module text).
     """
     if kind == "chain":
         return chain(n, d_t, axes, bearing)

@@ -36,9 +36,7 @@ def into_box(position, side):
 
     Parameters
     ----------
-    position : float
-        A position along the axis (m).
-    side : float
-        The box side along the axis (m).
+    position, side : float
+        A position along the axis, and the box side along it (m).
     """
     return position - side * np.floor(position / side)

@@ -10,6 +10,13 @@ obstacles; ``docs/gas.md`` derives them.
 * **(W2)** Within its reach, the part of the agent's other pushes that points into it is dropped
   (:func:`keep_off`), and the others get what the tilt limit leaves after the walls' pushes
   (:func:`with_priority`).
+
+The functions take agent ``i``'s slot; ``corrected``, each agent's ``(P*, P)`` per axis
+(``Agents.corrected``, shape (agents, axes, 2)); ``walls``, the walled box's sides (shape (axes,); 0:
+no walls on that axis, the box spans ``[0, side]``); ``obstacles``, each obstacle's centre and radius
+(m, shape (obstacles, axes + 1)); ``box``, the periodic box's sides (0: open axis); and the number
+of axes ``n_axes``.  A walled axis has two walls, at 0 and at ``side``, and each function takes them
+in that order, by the same arithmetic.
 """
 
 from __future__ import annotations
@@ -34,6 +41,17 @@ def _obstacle_gap(i, o, corrected, obstacles, box, n_axes):
 
 
 @numba.njit(cache=True, inline="always")
+def _wall_face(i, a, face, corrected, walls):
+    """Face ``face`` of axis ``a``'s walls as agent ``i`` sees it: 0, the wall at 0; 1, the wall at
+    ``walls[a]``.  Return the distance to it from the agent's ``P*`` and from its ``P`` (m), and
+    ``sign(d)`` along the axis (-1.0 or 1.0), ``d`` from the agent to the wall: the push ``U`` of (8)
+    on the agent is ``U sign(d)`` along ``a``."""
+    if face == 0:
+        return corrected[i, a, 0], corrected[i, a, 1], -1.0
+    return walls[a] - corrected[i, a, 0], walls[a] - corrected[i, a, 1], 1.0
+
+
+@numba.njit(cache=True, inline="always")
 def _first_push(pushed, i, contacts, n_axes):
     """Clear ``pushed[i]`` before the first push of agent ``i``'s step (``contacts`` so far 0): an agent
     out of every wall's reach, most of them, writes nothing."""
@@ -52,22 +70,12 @@ def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes
 
     Parameters
     ----------
-    i : int
-        The agent's slot.
-    corrected : ndarray, shape (agents, axes, 2)
-        Each agent's ``(P*, P)`` per axis (``Agents.corrected``).
+    i, corrected, walls, obstacles, box, n_axes
+        As every function here takes them (module text).
     pushed : ndarray, shape (agents, axes)
         The walls' pushes, written for agent ``i``.
-    walls : ndarray, shape (axes,)
-        The walled box's sides (0: no walls on that axis; the box spans ``[0, side]``).
-    obstacles : ndarray, shape (obstacles, axes + 1)
-        Each obstacle's centre and radius (m).
-    box : tuple of float
-        The periodic box's sides (0: open axis).
     wall_params : FunctionParams
         The repulsion's parameters with ``R + R_w`` for its reach (:func:`wall_params`).
-    n_axes : int
-        Number of axes.
     """
     contacts = 0
     pressing = 0.0
@@ -77,24 +85,16 @@ def wall_pushes(i, corrected, pushed, walls, obstacles, box, wall_params, n_axes
     reach = wall_params.reach
     for a in range(n_axes):
         if walls[a] > 0.0:
-            low = corrected[i, a, 0]
-            high = walls[a] - low
-            if low < reach:  # the wall at 0 lies at d = -low: its push points along +a
-                _first_push(pushed, i, contacts, n_axes)
-                u = repulsion(max(low, 0.0), 0, wall_params)
-                pushed[i, a] -= u
-                on_walls -= u
-                moment -= u * corrected[i, a, 1]
-                contacts += 1
-                pressing += (u / wall_params.c_max) ** 2
-            if high < reach:
-                _first_push(pushed, i, contacts, n_axes)
-                u = repulsion(max(high, 0.0), 0, wall_params)
-                pushed[i, a] += u
-                on_walls -= u
-                moment -= u * (walls[a] - corrected[i, a, 1])
-                contacts += 1
-                pressing += (u / wall_params.c_max) ** 2
+            for face in range(2):
+                gap, from_wall, toward = _wall_face(i, a, face, corrected, walls)
+                if gap < reach:
+                    _first_push(pushed, i, contacts, n_axes)
+                    u = repulsion(max(gap, 0.0), 0, wall_params)
+                    pushed[i, a] += toward * u  # u < 0 pushes away from the wall
+                    on_walls -= u
+                    moment -= u * from_wall
+                    contacts += 1
+                    pressing += (u / wall_params.c_max) ** 2
     for o in range(obstacles.shape[0]):
         centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
         if gap < reach and centre > 0.0:
@@ -119,36 +119,25 @@ def keep_off(i, corrected, setpoint, walls, obstacles, box, reach, n_axes):
 
     Parameters
     ----------
-    i : int
-        The agent's slot.
-    corrected : ndarray, shape (agents, axes, 2)
-        Each agent's ``(P*, P)`` per axis (``Agents.corrected``).
+    i, corrected, walls, obstacles, box, n_axes
+        As every function here takes them (module text).
     setpoint : ndarray, shape (agents, axes)
         The summed set-points, changed in place for agent ``i``.
-    walls : ndarray, shape (axes,)
-        The walled box's sides (0: no walls on that axis; the box spans ``[0, side]``).
-    obstacles : ndarray, shape (obstacles, axes + 1)
-        Each obstacle's centre and radius (m).
-    box : tuple of float
-        The periodic box's sides (0: open axis).
     reach : float
         ``R + R_w`` (m).
-    n_axes : int
-        Number of axes.
     """
     held = 0.0
     moment = 0.0
     obstacle_virial = 0.0
     for a in range(n_axes):
         if walls[a] > 0.0:
-            if corrected[i, a, 0] < reach and setpoint[i, a] < 0.0:
-                held -= setpoint[i, a]
-                moment -= setpoint[i, a] * corrected[i, a, 1]
-                setpoint[i, a] = 0.0
-            if walls[a] - corrected[i, a, 0] < reach and setpoint[i, a] > 0.0:
-                held += setpoint[i, a]
-                moment += setpoint[i, a] * (walls[a] - corrected[i, a, 1])
-                setpoint[i, a] = 0.0
+            for face in range(2):
+                gap, from_wall, toward = _wall_face(i, a, face, corrected, walls)
+                into = toward * setpoint[i, a]  # the part of the pushes towards the wall
+                if gap < reach and into > 0.0:
+                    held += into
+                    moment += into * from_wall
+                    setpoint[i, a] = 0.0
     for o in range(obstacles.shape[0]):
         centre, gap = _obstacle_gap(i, o, corrected, obstacles, box, n_axes)
         if gap < reach and centre > 0.0:

@@ -25,16 +25,12 @@ from tmem.figures.viewer.data import View
 
 #: The mark of a file written by ``tmem view`` (in the page's first line of comment).
 VIEW_MARK = "written by tmem view"
-#: The ES modules of the import map: name -> (folder, file).
+#: The ES modules of the import map: name -> (folder, file); the viewer's own, ``tmem/NAME``, are
+#: ``web/NAME.js``.
 MODULES = {
     "three": ("vendor", "three.module.min.js"),
     "three/addons/OrbitControls": ("vendor", "OrbitControls.js"),
-    "tmem/run": ("web", "run.js"),
-    "tmem/edges": ("web", "edges.js"),
-    "tmem/axes": ("web", "axes.js"),
-    "tmem/scene": ("web", "scene.js"),
-    "tmem/charts": ("web", "charts.js"),
-    "tmem/main": ("web", "main.js"),
+    **{f"tmem/{name}": ("web", f"{name}.js") for name in ("run", "edges", "axes", "scene", "charts", "main")},
 }
 #: The licences of the libraries inlined, appended to the page.
 LICENCES = ("LICENSE.three.txt", "LICENSE.uPlot.txt")

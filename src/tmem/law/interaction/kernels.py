@@ -1,8 +1,9 @@
 """Compiled interaction functions: one scalar kernel per row of the registry.
 
 Every kernel has one signature, ``kernel(r, f_en, p) -> U``: the pair
-measure's size ``r = |d| >= 0`` (m), with ``d = P*_j - P*_i`` of (6), the
-pair flag ``F_en``, and the parameters record :class:`FunctionParams`.  It
+measure's size ``r = |d| >= 0`` (m, a float), with ``d = P*_j - P*_i`` of (6),
+the pair flag ``F_en`` (an int), and the parameters record :class:`FunctionParams`
+(``K_P``, ``R + R_j``, ``d_t``, ``c_max``).  It
 returns agent ``i``'s tilt set-point contribution ``U`` (rad) for ``d > 0``,
 saturated at ``|U| <= c_max``; negative ``U`` pushes the agent away from its
 neighbour.  The functions are odd in ``d``, so for ``d < 0`` the contribution
@@ -95,10 +96,8 @@ def with_reach(p, reach):
 
     Parameters
     ----------
-    p : FunctionParams
-        The interaction functions' parameters.
-    reach : float
-        The reach (m).
+    p, reach
+        The interaction functions' parameters, and the reach (m) that replaces theirs.
     """
     return FunctionParams(*(p[:_REACH] + (reach,) + p[_AFTER_REACH:]))
 
@@ -122,32 +121,24 @@ def _spring(r, p):
 
 @numba.njit(cache=True, inline="always")
 def repulsion(r, f_en, p):
-    """Repulsion (8): ``K_P (r - reach)`` for ``r < reach``, else 0; saturated.  ``f_en`` is unused.
+    """Repulsion (8): ``K_P (r - reach)`` for ``r < reach``, else 0; saturated.
 
     Parameters
     ----------
-    r : float
-        The pair measure's size ``|d|`` (m).
-    f_en : int
-        The pair flag ``F_en``.
-    p : FunctionParams
-        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    r, f_en, p
+        As every kernel takes them (module text); ``f_en`` is unused.
     """
     return _saturate(_overlap(r, p), p.c_max)
 
 
 @numba.njit(cache=True, inline="always")
 def attraction(r, f_en, p):
-    """Attraction (Fig. 3): ``K_P (r - d_t)`` for ``r < reach``, else 0; saturated.  ``f_en`` is unused.
+    """Attraction (Fig. 3): ``K_P (r - d_t)`` for ``r < reach``, else 0; saturated.
 
     Parameters
     ----------
-    r : float
-        The pair measure's size ``|d|`` (m).
-    f_en : int
-        The pair flag ``F_en``.
-    p : FunctionParams
-        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    r, f_en, p
+        As every kernel takes them (module text); ``f_en`` is unused, as in :func:`repulsion`.
     """
     return _saturate(_spring(r, p), p.c_max) if r < p.reach else 0.0
 
@@ -158,12 +149,8 @@ def switching(r, f_en, p):
 
     Parameters
     ----------
-    r : float
-        The pair measure's size ``|d|`` (m).
-    f_en : int
-        The pair flag ``F_en``.
-    p : FunctionParams
-        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    r, f_en, p
+        As every kernel takes them (module text); ``f_en`` chooses between f1 and f2.
     """
     return _saturate(_overlap(r, p) if f_en == 0 else _spring(r, p), p.c_max)
 
@@ -174,12 +161,8 @@ def improved_switching(r, f_en, p):
 
     Parameters
     ----------
-    r : float
-        The pair measure's size ``|d|`` (m).
-    f_en : int
-        The pair flag ``F_en``.
-    p : FunctionParams
-        ``K_P``, ``R + R_j``, ``d_t``, ``c_max``.
+    r, f_en, p
+        As every kernel takes them (module text); ``f_en`` chooses, as in :func:`switching`.
     """
     if f_en != 0 or r < p.d_t:
         u = _spring(r, p)

@@ -44,22 +44,14 @@ class InteractionFunction:
 
 
 FUNCTIONS: tuple[InteractionFunction, ...] = (
-    InteractionFunction(
-        "repulsion", "repulsion", "(8)", couples=False, continuous=True,
-        summary="K_P c inside the spheres, 0 outside: pushes apart",
-    ),
-    InteractionFunction(
-        "attraction", "attraction", "Fig. 3", couples=False, continuous=False,
-        summary="K_P (d - s_d d_t) inside the spheres, 0 outside: apart closer than d_t, together farther",
-    ),
-    InteractionFunction(
-        "switching", "switching", "(10)", couples=True, continuous=True,
-        summary="repulsion (8) while uncoupled; K_P (d - s_d d_t) at any distance while coupled",
-    ),
-    InteractionFunction(
-        "improved", "improved_switching", "(11)", couples=True, continuous=True,
-        summary="a continuous f1 equal to f2 closer than d_t; f2 of (10) while coupled",
-    ),
+    InteractionFunction("repulsion", "repulsion", "(8)", couples=False, continuous=True,
+                        summary="K_P c inside the spheres, 0 outside: pushes apart"),
+    InteractionFunction("attraction", "attraction", "Fig. 3", couples=False, continuous=False,
+                        summary="K_P (d - s_d d_t) inside the spheres, 0 outside: apart closer than d_t, together farther"),
+    InteractionFunction("switching", "switching", "(10)", couples=True, continuous=True,
+                        summary="repulsion (8) while uncoupled; K_P (d - s_d d_t) at any distance while coupled"),
+    InteractionFunction("improved", "improved_switching", "(11)", couples=True, continuous=True,
+                        summary="a continuous f1 equal to f2 closer than d_t; f2 of (10) while coupled"),
 )  # fmt: skip
 
 #: The names, in the order of their integer codes.
