@@ -15,6 +15,7 @@ A test module's tests get its kind from :data:`MODULE_KINDS`; a test marked with
 keeps that one.
 """
 
+import gc
 from fnmatch import fnmatch
 
 import pytest
@@ -64,6 +65,21 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(kind)
     for module, item in unknown.items():
         item.warn(pytest.PytestWarning(f"tests/{module}.py has no kind: add it to MODULE_KINDS in tests/conftest.py"))
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_runtest_teardown(item, nextitem):
+    """Collect a test's garbage, then freeze what is left (``gc.freeze``) out of later collections.
+
+    What outlives a test is mostly Numba's: its first compiled loop leaves some 280 000 objects
+    alive for the session (types, signatures, the compiled library), each later one tens of
+    thousands more, and each full collection of Python's cyclic garbage collector scanned them all
+    again.  Measured on 2 cores:
+    the per-agent controllers' tests, then the viewer's and the exchange's, took 139 s of CPU with
+    them scanned and 106 s frozen.  Nothing a test checks depends on the collector.
+    """
+    gc.collect()
+    gc.freeze()
 
 
 TABLE1 = dict(kp=6.0, kd=25.0, g=9.8, r_l=12.0, im_l=0.1, im_r=0.55)
