@@ -27,7 +27,7 @@ from tmem.figures.viewer.data import FLYING, MAX_AGENTS, MAX_COORDINATES, MAX_FR
 from tmem.figures.viewer import data
 from tmem.figures.viewer.page import VIEW_MARK, headline, quantised
 
-VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "viewer" / "vendor"
+VENDOR = Path(__file__).resolve().parents[1] / "src" / "tmem" / "figures" / "viewer" / "vendor"
 
 
 def scenario_text(n_agents: int, n_axes: int, name: str = "synthetic") -> str:
