@@ -46,17 +46,29 @@ Skipped: examples/sweeps/parameters.toml (6000 cases, each its own batch:
 about 5 min on 2 cores); attraction swarms of more than 32 agents (a known
 bug there is to be fixed).
 
+``--write-digests FILE`` writes, beside the arrays, a SHA-256 digest of each pinned array of the
+items computed (:func:`digest`) and the environment that made them (:func:`environment`): the small
+JSON file ``tests/pin_digests.json`` that ``tests/test_pins.py`` holds a subset of the items to
+(:data:`DIGESTED`).  Made from the current code, and checked against a full pin set made with the
+same code::
+
+    PYTHONPATH=src python benchmarks/pin_results.py /tmp/pins/full
+    PYTHONPATH=src python benchmarks/pin_results.py /tmp/pins/digested --only $(python benchmarks/pin_results.py --digested) \
+        --write-digests tests/pin_digests.json
+    python benchmarks/pin_results.py --compare /tmp/pins/full /tmp/pins/digested --only $(python benchmarks/pin_results.py --digested)
+
 Usage::
 
     PYTHONPATH=src python benchmarks/pin_results.py /tmp/pins/base [--only fig9 gas-1000]
     PYTHONPATH=<new tree>/src python benchmarks/pin_results.py /tmp/pins/new
-    python benchmarks/pin_results.py --compare /tmp/pins/base /tmp/pins/new [--rtol 0]
+    python benchmarks/pin_results.py --compare /tmp/pins/base /tmp/pins/new [--rtol 0] [--only ITEM ...]
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import hashlib
 import itertools
 import json
 import os
@@ -83,6 +95,14 @@ SKIPPED = {
     "switch_at drawn per case), about 5 min on 2 cores",
     "attraction swarms > 32 agents": "a known bug there is to be fixed, changing their results",
 }
+
+
+#: The items tests/test_pins.py holds to their digests: about a minute on 2 cores once compiled.
+#: The paper's presets, the 19-agent hex for 20 s, gas-1000, a sensed example, a per-agent flight.
+DIGESTED = (
+    "preset-fig5", "preset-fig7", "preset-fig9", "preset-repulsion", "formation-hex19-20s", "gas-1000",
+    "sensing-fig9_noise", "agents-fig9",
+)  # fmt: skip
 
 
 @dataclasses.dataclass(frozen=True)
@@ -302,8 +322,45 @@ def items(examples: Path) -> list[Item]:
 # --- writing and comparing -----------------------------------------------------------------------
 
 
-def pin(out: Path, examples: Path, only: list[str] | None) -> None:
-    """Compute the items (those named in ``only``, or all) and write them with the index to ``out``."""
+def digest(array: np.ndarray) -> str:
+    """SHA-256 of an array's dtype, shape and bytes, in hexadecimal: equal digests, equal bits."""
+    array = np.ascontiguousarray(array)
+    return hashlib.sha256(f"{array.dtype.str} {array.shape} ".encode() + array.tobytes()).hexdigest()
+
+
+def environment() -> dict[str, str]:
+    """What the bits depend on besides the code: Numba, LLVM (llvmlite's and its version), NumPy,
+    SciPy (the gains' and the zero-order hold's linear algebra), Python, and the processor (the
+    kernels are compiled for it, and the linear algebra picks its routines by it)."""
+    import llvmlite
+    import llvmlite.binding as llvm
+    import numba
+    import scipy
+
+    return {
+        "numba": numba.__version__, "llvmlite": llvmlite.__version__,
+        "llvm": ".".join(map(str, llvm.llvm_version_info)), "numpy": np.__version__, "scipy": scipy.__version__,
+        "python": platform.python_version(), "machine": platform.machine(), "cpu": llvm.get_host_cpu_name(),
+    }  # fmt: skip
+
+
+def write_digests(path: Path, found: dict[str, tuple[str, dict[str, np.ndarray]]]) -> None:
+    """Write ``{item: (what, arrays)}`` as their digests, with the environment, to ``path`` (JSON)."""
+    text = {
+        "about": "Regression pins: SHA-256 digests of the arrays benchmarks/pin_results.py pins, made by "
+        "`pin_results.py OUTDIR --only ... --write-digests` from the code of the commit that wrote this file; "
+        "tests/test_pins.py recomputes them and compares",
+        "environment": environment(),
+        "items": {name: {"what": what, "arrays": {key: digest(a) for key, a in sorted(arrays.items())}}
+                  for name, (what, arrays) in found.items()},
+    }  # fmt: skip
+    path.write_text(json.dumps(text, indent=1) + "\n")
+    print(f"digests of {len(found)} items written to {path}")
+
+
+def pin(out: Path, examples: Path, only: list[str] | None, digests: Path | None = None) -> None:
+    """Compute the items (those named in ``only``, or all) and write them with the index to ``out``;
+    their digests to ``digests`` if given (:func:`write_digests`)."""
     import numba
     import tmem
 
@@ -320,11 +377,15 @@ def pin(out: Path, examples: Path, only: list[str] | None) -> None:
         "skipped": SKIPPED,
     }
     total = time.perf_counter()
+    found = {}
     for item in todo:
         started = time.perf_counter()
         arrays = item.compute()
         seconds = time.perf_counter() - started
         np.savez(out / f"{item.name}.npz", **arrays)
+        if digests is not None:
+            with np.load(out / f"{item.name}.npz") as saved:  # what --compare reads: the digests of the file's arrays
+                found[item.name] = (item.what, dict(saved))
         index["items"][item.name] = {
             "what": item.what,
             "seconds": round(seconds, 3),
@@ -334,6 +395,8 @@ def pin(out: Path, examples: Path, only: list[str] | None) -> None:
     index["seconds"] = round(time.perf_counter() - total, 3)
     (out / "index.json").write_text(json.dumps(index, indent=1) + "\n")
     print(f"{len(todo)} items in {index['seconds']:.1f} s, written to {out}")
+    if digests is not None:
+        write_digests(digests, found)
 
 
 def relative_difference(old: np.ndarray, new: np.ndarray) -> float:
@@ -355,11 +418,12 @@ def identical(old: np.ndarray, new: np.ndarray) -> bool:
     return old.dtype == new.dtype and old.shape == new.shape and old.tobytes() == new.tobytes()
 
 
-def compare(old: Path, new: Path, rtol: float) -> bool:
-    """Print one line per item (and one per differing array); return whether all match within ``rtol``."""
+def compare(old: Path, new: Path, rtol: float, only: list[str] | None = None) -> bool:
+    """Print one line per item (those named in ``only``, or all) and one per differing array; return
+    whether all match within ``rtol``."""
     names = [json.loads((d / "index.json").read_text())["items"] for d in (old, new)]
     ok = True
-    for name in sorted(set(names[0]) | set(names[1])):
+    for name in sorted(set(only) if only else set(names[0]) | set(names[1])):
         if name not in names[0] or name not in names[1]:
             print(f"{name:32} missing in {old if name not in names[0] else new}")
             ok = False
@@ -394,13 +458,19 @@ def main() -> None:
     parser.add_argument("--compare", nargs=2, type=Path, metavar=("OLD", "NEW"), help="compare two result directories")
     parser.add_argument("--rtol", type=float, default=0.0, help="largest relative difference accepted (default 0)")
     parser.add_argument("--examples", type=Path, default=ROOT / "examples", help="where the example scenarios are")
-    parser.add_argument("--only", nargs="+", metavar="ITEM", help="pin only these items")
+    parser.add_argument("--only", nargs="+", metavar="ITEM", help="pin (or compare) only these items")
+    parser.add_argument("--write-digests", type=Path, metavar="FILE",
+                        help="also write the SHA-256 digests of the items' arrays to FILE (tests/pin_digests.json)")
+    parser.add_argument("--digested", action="store_true", help="print the items tests/test_pins.py holds, and exit")
     args = parser.parse_args()
+    if args.digested:
+        print(" ".join(DIGESTED))
+        return
     if args.compare:
-        sys.exit(0 if compare(*args.compare, args.rtol) else 1)
+        sys.exit(0 if compare(*args.compare, args.rtol, args.only) else 1)
     if args.out is None:
         parser.error("give OUTDIR, or --compare OLD NEW")
-    pin(args.out, args.examples.resolve(), args.only)
+    pin(args.out, args.examples.resolve(), args.only, args.write_digests)
 
 
 if __name__ == "__main__":

@@ -2,13 +2,14 @@
 
 The loop over controllers (:func:`tmem.agent.fly`) is checked against :func:`tmem.simulate`, an
 independent implementation of the same law (one compiled loop over the whole swarm, in its own
-numbering of the agents): states, set-points, flags and events must be equal to the bit.  The
+numbering of the agents): states, set-points, flags and events must be equal to the bit, the
+product's claim (docs/agent_controller.md, "Same bits as the engine").  The
 runs are short (the loop is Python); fig9's is the one that couples, gets its command and
 uncouples, with the command moved from 29 s to 5 s.
 """
 
 import re
-import subprocess
+import runpy
 import sys
 from pathlib import Path
 
@@ -150,6 +151,7 @@ def test_controllers_built_by_hand_fly_as_those_of_the_scenario():
     assert np.array_equal(ours.state, theirs.state) and ours.events == theirs.events
 
 
+@pytest.mark.interface
 def test_the_message_goes_over_the_wire_and_back():
     controllers, states = _pair()
     message = controllers[0].message(states[0], 1.5)
@@ -160,6 +162,7 @@ def test_the_message_goes_over_the_wire_and_back():
     assert np.array_equal(back.vectors, message.vectors)
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize(
     "values, field",
     [([0.0, 1.0, 1.0, 2.0, 3.0], "3 axes numbers"), ([0.5, 0.0, 1.0, 1.0, 2.0, 3.0], "sender"),
@@ -193,6 +196,7 @@ BAD = [
 ]
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("changes, field", BAD, ids=[field for _, field in BAD])
 def test_bad_construction_input_is_refused_in_one_line_naming_the_field(changes, field):
     settings = {"gains": GAINS, "dt": 1e-3, **changes}
@@ -202,6 +206,7 @@ def test_bad_construction_input_is_refused_in_one_line_naming_the_field(changes,
     assert "\n" not in message and f"{field}" in message, message
 
 
+@pytest.mark.interface
 def test_bad_tables_and_update_input_are_refused_in_one_line():
     with pytest.raises(ControllerError, match=r"^Edge: d_t: must be greater than 0"):
         Edge(neighbour=1, d_t=-3.0)
@@ -231,6 +236,7 @@ REFUSED = [
 ]
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("scenario, field", REFUSED, ids=[field for _, field in REFUSED])
 def test_what_per_agent_controllers_do_not_do_is_refused_in_one_line(scenario, field):
     for attempt in (lambda: controllers_for(scenario), lambda: fly(scenario)):
@@ -239,6 +245,7 @@ def test_what_per_agent_controllers_do_not_do_is_refused_in_one_line(scenario, f
         assert "\n" not in str(caught.value)
 
 
+@pytest.mark.interface
 def test_a_scenario_with_sensing_effects_is_not_flown():
     """fly() passes every message exactly: a [sensing] table with effects would not be honoured."""
     noisy = with_changes(tmem.preset("fig9"), {"sensing": {"position_noise": 0.1}})
@@ -255,8 +262,9 @@ def test_reset_starts_the_controller_again():
     assert np.array_equal(first, again)
 
 
-def test_the_example_flies_the_engines_bits():
-    result = subprocess.run([sys.executable, str(EXAMPLES / "vehicles/per_agent_loop.py"), "--duration", "0.3"],
-                            capture_output=True, text=True, timeout=600)  # fmt: skip
-    assert result.returncode == 0, result.stderr
-    assert "the same bits as tmem.simulate: yes" in result.stdout
+@pytest.mark.interface
+def test_the_example_flies_the_engines_bits(monkeypatch, capsys):
+    """examples/vehicles/per_agent_loop.py, run as a script in this process (it needs no process of its own)."""
+    monkeypatch.setattr(sys, "argv", ["per_agent_loop.py", "--duration", "0.3"])
+    runpy.run_path(str(EXAMPLES / "vehicles/per_agent_loop.py"), run_name="__main__")
+    assert "the same bits as tmem.simulate: yes" in capsys.readouterr().out

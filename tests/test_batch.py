@@ -1,4 +1,10 @@
-"""The batched two-agent loop against the full engine, case by case."""
+"""The batched two-agent loop against the full engine, case by case.
+
+The batch gives the engine's figures (its claim): each case's RMS change, distances, final
+velocities and coupling times equal tmem.simulate's of the same start within rounding (the batch
+skips free flight in closed form and steps the pair's relative state), and its uncoupling rule
+is the same.
+"""
 
 import numpy as np
 import pytest
@@ -41,10 +47,13 @@ def test_batch_equals_the_engine(function, switch_at):
         _agrees_with_the_engine(batch, k, base, (p, v))
 
 
+@pytest.mark.slow  # compiles the batch that steps both agents on one axis for this test alone
 @pytest.mark.parametrize("function", ["switching", "improved"])
 def test_the_two_paths_agree_on_one_axis(function):
     """Under the window rule, one axis runs on the relative state (tmem.batch.relative); with the energy
-    rule or synchronisation it steps both agents.  Each against the engine."""
+    rule or synchronisation it steps both agents.  Each against the engine.  The default run checks
+    the path that steps both agents in the plane (test_batch_equals_the_engine_in_the_plane:
+    energy-11, energy-sync-10), the same source on two axes."""
     base = with_changes(tmem.preset("fig9"), {"interaction.function": function, "simulation.duration": 45.0})
     positions = np.array([p for p, _ in STARTS])
     velocities = np.array([v for _, v in STARTS])
@@ -87,6 +96,7 @@ def test_batch_equals_the_engine_in_the_plane(interaction):
         assert batch.coupled[:2].all() and not batch.coupled[2]  # head-on and angled couple; the wide pass does not
 
 
+@pytest.mark.interface
 def test_batch_refuses_what_it_cannot_run():
     with pytest.raises(ValueError, match="two agents"):
         run_batch(tmem.load("examples/swarm/triangle.toml"), np.zeros((1, 2)), np.zeros((1, 2)))
@@ -108,6 +118,7 @@ BAD_STARTS = {
 }
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("name", BAD_STARTS, ids=list(BAD_STARTS))
 def test_bad_starts_are_refused_in_one_line(name):
     """As ``tmem run`` refuses them (regression: these ran, returning NaN or +167 %)."""
@@ -118,6 +129,7 @@ def test_bad_starts_are_refused_in_one_line(name):
     assert "\n" not in message and message.startswith("run_batch: ") and where in message, message
 
 
+@pytest.mark.interface
 def test_a_scenario_that_is_not_one_is_refused():
     with pytest.raises(ValueError, match="run_batch: scenario: must be a tmem Scenario"):
         run_batch({"name": "fig9"}, [[50.0, 0.0]], [[-1.5, 3.0]])

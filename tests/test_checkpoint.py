@@ -3,7 +3,7 @@
 The reference is always the same scenario run from start to end without checkpoints.  In-process,
 a run with checkpoints is stopped (an exception from its progress callback) right after a
 checkpoint, and a new run resumes from the file; every array of the two trajectories must be equal
-bit for bit.  The real command is killed with SIGKILL after it wrote a checkpoint, run again, and
+bit for bit, the product's claim (docs/checkpoints.md).  The real command is killed with SIGKILL after it wrote a checkpoint, run again, and
 its files compared with an uninterrupted run's.  A checkpoint of another scenario or another tmem
 is refused in one line.
 """
@@ -151,6 +151,7 @@ def test_a_resumed_run_ends_with_the_same_bits(case, tmp_path):
     assert resumed.events == reference.events
 
 
+@pytest.mark.interface
 def test_every_field_of_a_changing_record_is_saved_or_declared_rebuilt(tmp_path):
     """From the file itself: each field of each record a step changes is in it, or in REBUILT with a
     reason, never both; and every record of tmem.engine.records is either changing or fixed."""
@@ -170,6 +171,7 @@ def test_every_field_of_a_changing_record_is_saved_or_declared_rebuilt(tmp_path)
     assert defined <= set(ckpt.CHANGING.values()) | set(ckpt.FIXED_RECORDS), defined
 
 
+@pytest.mark.interface
 def test_a_field_that_is_not_an_array_must_be_declared():
     class Widened(NamedTuple):
         state: np.ndarray
@@ -264,6 +266,7 @@ def one_line_refusal(result, *words) -> str:
     return result.stderr
 
 
+@pytest.mark.interface
 def test_a_checkpoint_of_another_scenario_is_refused_and_kept(left_checkpoint):
     scenario, out, saved = left_checkpoint
     before = saved.read_bytes()
@@ -272,6 +275,7 @@ def test_a_checkpoint_of_another_scenario_is_refused_and_kept(left_checkpoint):
     assert saved.read_bytes() == before and not out.exists()
 
 
+@pytest.mark.interface
 def test_a_checkpoint_of_another_tmem_is_refused(left_checkpoint):
     scenario, out, saved = left_checkpoint
     with np.load(saved) as data:
@@ -285,6 +289,7 @@ def test_a_checkpoint_of_another_tmem_is_refused(left_checkpoint):
     assert saved.exists() and not out.exists()
 
 
+@pytest.mark.interface
 def test_a_file_that_is_not_a_checkpoint_is_refused_and_kept(tmp_path):
     scenario = tmp_path / "pair.toml"
     scenario.write_text((ROOT / "examples/fig9.toml").read_text().replace("duration = 60.0", "duration = 35.0"))
@@ -294,6 +299,7 @@ def test_a_file_that_is_not_a_checkpoint_is_refused_and_kept(tmp_path):
     assert notes.read_text() == "my notes\n"
 
 
+@pytest.mark.interface
 def test_ctrl_c_keeps_the_checkpoint_and_says_where_the_command_goes_on(tmp_path, monkeypatch):
     """Ctrl-C arriving right after the checkpoint at 10 s (raised from its save, in-process)."""
     scenario = tmp_path / "pair.toml"
@@ -311,6 +317,7 @@ def test_ctrl_c_keeps_the_checkpoint_and_says_where_the_command_goes_on(tmp_path
     assert checkpoint_path(tmp_path / "out").exists() and not (tmp_path / "out").exists()
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("every,why", [("0", "positive"), ("-5", "positive"), ("nan", "positive"), ("1e-5", "at least the time step")])
 def test_bad_checkpoint_intervals_are_refused(tmp_path, every, why):
     scenario = tmp_path / "pair.toml"
@@ -319,6 +326,7 @@ def test_bad_checkpoint_intervals_are_refused(tmp_path, every, why):
     assert not (tmp_path / "out").exists() and not checkpoint_path(tmp_path / "out").exists()
 
 
+@pytest.mark.interface
 def test_the_python_interval_is_checked_too(tmp_path):
     with pytest.raises(CheckpointError, match="positive"):
         Checkpoints(tmp_path / "c.npz", float("inf"))

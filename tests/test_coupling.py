@@ -46,6 +46,7 @@ def test_crossing_transitions(f_en, armed, r_before, r, expected):
     assert next_flag(f_en, armed, r_before, r, D_T, EPS, True) == expected
 
 
+@pytest.mark.physics
 @pytest.mark.parametrize("preset", ["fig7", "fig9"])
 def test_crossing_switches_closer_to_d_t_than_the_window(preset):
     """The crossing rule flips the flag where the interaction distance is d_t, the window rule

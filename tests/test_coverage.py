@@ -235,6 +235,7 @@ def test_the_largest_grid_is_allowed():
 # --- the figure ---------------------------------------------------------------------------------
 
 
+@pytest.mark.interface
 def test_plot_coverage_draws_one_image_with_a_colour_bar():
     pytest.importorskip("matplotlib")
     import matplotlib
@@ -256,6 +257,7 @@ def test_plot_coverage_draws_one_image_with_a_colour_bar():
     fig.savefig(__import__("io").BytesIO(), format="png")
 
 
+@pytest.mark.interface
 def test_plot_coverage_on_given_axes_and_on_a_line():
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure

@@ -1,8 +1,6 @@
 """agents_from: a scenario's agents from a Crazyswarm2 crazyflies.yaml (its robots: NAME: {enabled, uri,
 initial_position: [x, y, z], type} layout), and the one-line refusals of a file that does not fit."""
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -166,9 +164,13 @@ def test_agent_names_are_unique_and_not_another_agents_number():
 
 
 def test_the_command_refuses_a_missing_yaml_in_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from tmem.cli.main import app
+
     path = _scenario(tmp_path, yaml_name="config/absent.yaml")
-    proc = subprocess.run([sys.executable, "-m", "tmem", "run", str(path), "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True, timeout=120)  # fmt: skip
-    lines = proc.stderr.strip().splitlines()
-    assert proc.returncode == 2 and len(lines) == 1 and "agents_from:" in lines[0] and "no such file" in lines[0], proc.stderr
+    result = CliRunner().invoke(app, ["run", str(path), "--out", str(tmp_path / "out")])  # in-process: no real process needed
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert len(lines) == 1 and "agents_from:" in lines[0] and "no such file" in lines[0], result.stderr
     assert not (tmp_path / "out").exists()

@@ -5,8 +5,6 @@ and compared with the run; the command's refusals and its atomic writes."""
 import csv
 import importlib
 import pkgutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -260,8 +258,11 @@ def test_csv_of_a_3d_run_names_each_file_by_the_agents_number(gas3d, tmp_path):
 # The command
 
 
-def _tmem(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "tmem", *args], capture_output=True, text=True, timeout=300, cwd=cwd)
+def _tmem(*args: str):
+    """The command run in-process (its refusals need no process of their own); exit code and stderr."""
+    result = CliRunner().invoke(app, list(args))
+    assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
+    return result.exit_code, result.stderr
 
 
 def test_the_command_writes_beside_the_run_by_default_and_replaces_its_own(triangle, tmp_path):
@@ -282,8 +283,8 @@ def test_the_command_writes_beside_the_run_by_default_and_replaces_its_own(trian
 ])  # fmt: skip
 def test_a_folder_that_is_not_a_run_is_refused_in_one_line(tmp_path, args, message):
     (tmp_path / "notes.txt").write_text("mine")
-    proc = _tmem("export", str(tmp_path), *args)
-    assert proc.returncode == 2 and proc.stderr.strip() == message.format(dir=tmp_path), proc.stderr
+    code, stderr = _tmem("export", str(tmp_path), *args)
+    assert code == 2 and stderr.strip() == message.format(dir=tmp_path), stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
 
 
@@ -291,9 +292,9 @@ def test_a_netcdf_file_that_is_not_a_runs_trajectory_is_refused(tmp_path):
     import xarray as xr
 
     xr.Dataset({"a": ("t", np.arange(3.0))}).to_netcdf(tmp_path / "trajectory.nc", engine="h5netcdf")
-    proc = _tmem("export", str(tmp_path), "--to", "mcap")
-    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
-    assert "is not the trajectory of a tmem run" in proc.stderr
+    code, stderr = _tmem("export", str(tmp_path), "--to", "mcap")
+    assert code == 2 and len(stderr.strip().splitlines()) == 1, stderr
+    assert "is not the trajectory of a tmem run" in stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["trajectory.nc"]
 
 

@@ -85,7 +85,7 @@ def test_without_drag_the_airframe_under_the_acceleration_loop_is_the_papers_mod
     np.testing.assert_allclose(a[:4, :4], a2, atol=1e-4)  # (P, V, phi, omega) move as (2) ...
     np.testing.assert_allclose(a[:4, 4:], 0.0, atol=1e-4)  # ... whatever the reference does
     np.testing.assert_allclose(b[:4], b2, atol=1e-4)
-    np.testing.assert_array_equal(model.linearisation()[0], a2)
+    np.testing.assert_array_equal(model.linearisation()[0], a2)  # (2) exactly without drag, as its docstring says
 
 
 @pytest.mark.parametrize("axis", [0, 1])

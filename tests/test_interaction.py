@@ -48,6 +48,8 @@ def test_matches_literal_transcription_everywhere(function, f_en):
 
 @pytest.mark.parametrize("function,f_en", CASES)
 def test_odd_in_d_and_saturated(function, f_en):
+    """Odd to the bit, in any floating-point format: the kernels take ``|d|`` and the sign is set
+    after, so ``-d`` gives exactly ``-U`` (two agents of a pair get exactly opposite pushes)."""
     u = interaction.evaluate(function, GRID, f_en, **PARAMS)
     u_mirror = interaction.evaluate(function, -GRID, f_en, **PARAMS)
     np.testing.assert_array_equal(u, -u_mirror)
@@ -79,6 +81,7 @@ def test_improved_f1_is_continuous_at_b_and_d_t():
 
 
 def test_improved_f1_equals_f2_inside_d_t():
+    """Equal to the bit: inside d_t both branches are the same expression K_P (r - d_t), saturated."""
     d = np.linspace(-D_T, D_T, 1001)
     np.testing.assert_array_equal(f("improved", d, 0), f("improved", d, 1))
 
@@ -117,7 +120,7 @@ def test_every_function_is_saturated_odd_and_repels_when_close(row):
     for f_en in (0, 1) if row.couples else (0,):
         u = f(row.name, FINE, f_en)
         assert np.all(np.abs(u) <= C_MAX)
-        np.testing.assert_array_equal(u, -f(row.name, -FINE, f_en))
+        np.testing.assert_array_equal(u, -f(row.name, -FINE, f_en))  # odd to the bit: see test_odd_in_d_and_saturated
     close = np.linspace(0.01, 5.0, 50)
     assert np.all(f(row.name, close, 0) < 0)  # pushes apart (U < 0 for d > 0) when nearly touching
 
@@ -150,6 +153,7 @@ def test_each_row_names_a_kernel_and_its_code_dispatches_to_it(row):
             assert f(row.name, r, f_en) == expected
 
 
+@pytest.mark.interface
 def test_the_documented_table_of_functions_is_the_registry():
     """docs/equations.md lists one row per registered function, in registry order, with its equation,
     and a coupled column exactly for the functions that switch on F_en."""

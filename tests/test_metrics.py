@@ -138,6 +138,7 @@ def test_every_agent_gone_gives_null_not_inf_or_nan():
     json.dumps(s, allow_nan=False)
 
 
+@pytest.mark.interface
 def test_table_marks_an_rms_change_taken_while_coupled():
     from rich.console import Console
 
@@ -226,6 +227,7 @@ def test_summary_gives_the_largest_rms_change_on_the_way_and_when():
     assert s["rms_change_percent"] == pytest.approx(changes[3])
 
 
+@pytest.mark.physics
 @pytest.mark.parametrize("kind, n", [("triangle", None), ("chain", 4), ("ring", 6)])
 def test_formations_report_coupled_from_the_start_and_after_a_loss(kind, n):
     """A formation starts coupled (no couple event) and a ring losing an agent keeps the rest."""
@@ -247,6 +249,7 @@ def test_formations_report_coupled_from_the_start_and_after_a_loss(kind, n):
     assert s["rms_change_while_coupled"] is True
 
 
+@pytest.mark.interface
 def test_the_table2_pair_left_coupled_is_flagged_in_summary_and_table(tmp_path):
     """Without its uncouple command the pair is still coupled at the end: its RMS change is marked as swinging."""
     import json

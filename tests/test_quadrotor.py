@@ -149,7 +149,7 @@ def test_without_drag_the_quadrotor_at_hover_is_the_papers_model_2(axis):
     a2, b2 = state_matrices(6.0, 25.0, 9.81)
     np.testing.assert_allclose(a, a2, atol=1e-4)
     np.testing.assert_allclose(b, b2, atol=1e-4)
-    np.testing.assert_array_equal(model.linearisation()[0], a2)
+    np.testing.assert_array_equal(model.linearisation()[0], a2)  # "Without drag it is (2) exactly" (its docstring)
 
 
 @pytest.mark.parametrize("feedforward", [True, False])

@@ -65,6 +65,7 @@ def test_the_body_state_is_recorded_and_written(runs):
 
 
 def test_an_agent_added_back_starts_again_with_its_body():
+    """An agent added back starts from its entry's body state and state, exactly: they are copied."""
     commands = [{"time": 3.0, "action": "remove", "agent": 1}, {"time": 5.0, "action": "add", "agent": 1}]
     trajectory = tmem.simulate(two_agents(2, commands=commands))
     added = int(np.argmin(np.abs(trajectory.time - 5.0)))
@@ -74,6 +75,7 @@ def test_an_agent_added_back_starts_again_with_its_body():
     assert np.all(trajectory.body[removed, 1] == trajectory.body[np.flatnonzero(removed)[0], 1])  # not stepped
 
 
+@pytest.mark.interface
 def test_the_continuous_reference_refuses_the_quadrotor_in_one_line():
     from tmem.analysis.reference import integrate
 
@@ -83,7 +85,10 @@ def test_the_continuous_reference_refuses_the_quadrotor_in_one_line():
     assert "\n" not in str(refused.value)
 
 
+@pytest.mark.slow  # the same threaded quadrotor loop as tests/test_wind.py's gusts on threads, which run by default
 def test_the_quadrotor_swarm_on_threads_is_the_serial_one(monkeypatch):
+    """Threads give the serial loop's bits (the product's claim), on the quadrotor in calm air.  The
+    default run checks it in a turbulent wind (tests/test_wind.py), on one and on two threads."""
     from tmem.engine import driver
 
     gas = from_dict({

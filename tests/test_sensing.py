@@ -57,6 +57,7 @@ def held_message(tr: tmem.Trajectory) -> np.ndarray:
     return sent
 
 
+@pytest.mark.unit
 def test_the_hash_is_splitmix64():
     """The compiled hash against a pure-Python SplitMix64 (Vigna's splitmix64.c): its first output
     from state 0 is the published 0xE220A8397B1DCDAF, and a draw is the chain over its five numbers."""
@@ -82,6 +83,7 @@ def test_the_hash_is_splitmix64():
         assert uniform(key, draw) == ((h >> 11) + 0.5) / 2**53
 
 
+@pytest.mark.unit
 def test_normal_draws_are_standard_normal_and_independent():
     """100 000 pairs of draws over steps and senders: each draw's mean, variance (chi-square) and
     Kolmogorov-Smirnov test against the normal law, and no correlation within a pair, between

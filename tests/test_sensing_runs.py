@@ -1,6 +1,10 @@
 """Sensed runs: the same bits on any number of threads and with either kind of neighbour list; the
 sensed path without effects gives the exact path's bits; bad ``[sensing]`` tables are refused in one
-line; the examples run."""
+line; the examples run.
+
+The bit-equalities are the product's claims (docs/sensing.md): the draws are keyed by the message,
+never by the order pairs are visited in; and the sensed path adds its effects and nothing else.
+"""
 
 from __future__ import annotations
 
@@ -34,7 +38,8 @@ def swarm(method: str, sensing: dict | None, n: int = 200, steps: int = 300) -> 
 
 def test_lists_and_all_pairs_give_the_same_bits(monkeypatch):
     """Noise, random delays, loss and a range: the Verlet lists (over positions, rebuilt on the way)
-    and every pair give the same bits, with small blocks so that many pairs cross between them."""
+    and every pair give the same bits (the claim, so bit for bit), with small blocks so that many
+    pairs cross between them."""
     monkeypatch.setattr(lists, "BLOCK", 64)
     every = tmem.simulate(swarm("all", EVERYTHING))
     listed = tmem.simulate(swarm("verlet", EVERYTHING))
@@ -46,6 +51,7 @@ def test_lists_and_all_pairs_give_the_same_bits(monkeypatch):
 
 
 def test_one_thread_two_threads_and_the_serial_loop_give_the_same_bits(monkeypatch):
+    """Threads give the serial loop's bits (the product's claim), with every sensing effect on."""
     monkeypatch.setattr(lists, "BLOCK", 32)  # several blocks, summed on threads, and pairs between them
     monkeypatch.setattr(driver, "THREADED_SWARM", 100)
     scenario = swarm("verlet", EVERYTHING)
@@ -65,7 +71,10 @@ def test_one_thread_two_threads_and_the_serial_loop_give_the_same_bits(monkeypat
 @pytest.mark.parametrize("case", ["fig9", "swarm"])
 def test_the_sensed_path_without_effects_gives_the_exact_bits(case):
     """Each agent pushing from its own exact measurement gives the exact path's equal and opposite
-    pushes to the bit: Fig. 9 (a formation pair, its events and its recorded |d|), and a swarm."""
+    pushes to the bit: Fig. 9 (a formation pair, its events and its recorded |d|), and a swarm.  Bit
+    for bit because it is the same arithmetic on the same numbers: the functions are odd to the bit
+    (tests/test_interaction.py), so an agent's own push is the exact path's, and the sensed path
+    claims to add its effects and nothing else."""
     scenario = (with_changes(tmem.preset("fig9"), {"simulation.dt": 0.01, "simulation.record_every": 10})
                 if case == "fig9" else swarm("all", None))  # fmt: skip
     exact = tmem.simulate(scenario)
@@ -77,7 +86,8 @@ def test_the_sensed_path_without_effects_gives_the_exact_bits(case):
 
 
 def test_a_seed_chooses_the_draws():
-    """The same seed gives the same bits; another seed, another run."""
+    """The same seed gives the same bits (a run is reproducible: the claim of tmem.world.streams);
+    another seed, another run."""
     fig9 = with_changes(tmem.preset("fig9"), {"simulation.dt": 0.01, "simulation.duration": 5.0, "commands": []})
     run = lambda seed: tmem.simulate(with_changes(fig9, {"sensing": {"seed": seed, "position_noise": 0.3}}))  # noqa: E731
     assert run(1).final_state.tobytes() == run(1).final_state.tobytes()
@@ -119,6 +129,7 @@ BAD = {
 }
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("name", BAD, ids=list(BAD))
 def test_a_bad_sensing_table_is_refused_in_one_line(name, tmp_path):
     base, table, field = BAD[name]
@@ -132,11 +143,13 @@ def test_a_bad_sensing_table_is_refused_in_one_line(name, tmp_path):
     assert "Traceback" not in result.output and not out.exists()
 
 
+@pytest.mark.interface
 def test_the_sensing_table_is_not_a_table():
     with pytest.raises(tmem.ScenarioError, match="sensing: must be a table"):
         tmem.loads("sensing = 3\n" + FIG9)  # a key before the first table is the scenario's
 
 
+@pytest.mark.interface
 def test_what_the_sensed_path_cannot_do_is_refused_in_one_line():
     """Through the Python API too: the gas's stages, and lists without a range; and the batch."""
     gas = with_changes(swarm("all", None), {"simulation.observe_gas": True})
@@ -151,6 +164,7 @@ def test_what_the_sensed_path_cannot_do_is_refused_in_one_line():
         run_batch(noisy, np.zeros((1, 2)), np.zeros((1, 2)))
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.stem)
 def test_sensing_examples_run(path):
     scenario = tmem.load(path)

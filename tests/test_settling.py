@@ -202,9 +202,13 @@ def test_energy_rule_falls_back_on_the_window_after_one_period():
 
 
 def test_window_rule_names_itself_and_the_default_is_unchanged():
+    """Fig. 9 releases its pair by the window rule (9) at about 30.8 s, as the paper's figure shows it.
+    To 0.01 s, a hundred steps: the release is the step the pair crosses into (9)'s window, which
+    another rounding (another backend, float32) may move by a step or so.  The bits of the default
+    run are pinned in tests/test_pins.py (preset-fig9)."""
     tr = tmem.simulate(tmem.preset("fig9"))
     (released,) = [e for e in tr.events if e.kind == "uncouple"]
-    assert released.rule == "window" and released.time == pytest.approx(30.7925)
+    assert released.rule == "window" and released.time == pytest.approx(30.79, abs=0.01)
     assert summarize(tr)["events"][-1]["rule"] == "window"
 
 

@@ -61,6 +61,8 @@ def random_swarm(n: int, axes: int, periodic: bool, method: str, steps: int = 30
 
 @pytest.mark.parametrize("axes,periodic", [(2, False), (2, True), (3, True)])
 def test_verlet_lists_give_the_same_bits_as_all_pairs(axes, periodic):
+    """Verlet lists and every pair give the same bits: the product's claim (docs/swarms.md), so bit
+    for bit: each agent's pushes are summed in the same order either way."""
     a = tmem.simulate(random_swarm(500, axes, periodic, "all"))
     b = tmem.simulate(random_swarm(500, axes, periodic, "verlet"))
     assert b.list_builds > 1  # the lists were rebuilt along the way
@@ -68,7 +70,11 @@ def test_verlet_lists_give_the_same_bits_as_all_pairs(axes, periodic):
     assert np.abs(a.final_state).max() > 0 and a.min_neighbor_distance == b.min_neighbor_distance
 
 
+@pytest.mark.slow  # the plain threaded loop is compiled for this test alone: see below
 def test_threaded_loop_gives_the_same_bits_as_the_serial_one(monkeypatch):
+    """Threads give the serial loop's bits, the product's claim (docs/swarms.md), in blocks of 32.
+    In the default run tests/test_gas.py checks the claim on the threaded loop with the gas's
+    stages, in blocks too; this one is the plain swarm's."""
     monkeypatch.setattr(lists, "BLOCK", 32)  # several blocks, summed on both threads
     monkeypatch.setattr(engine, "THREADED_SWARM", 100)
     scenario = random_swarm(200, 2, True, "verlet")
@@ -81,7 +87,8 @@ def test_threaded_loop_gives_the_same_bits_as_the_serial_one(monkeypatch):
 @pytest.mark.parametrize("axes", [2, 3])
 def test_blocks_keep_verlet_lists_and_all_pairs_equal(monkeypatch, axes):
     """With small blocks many pairs cross between blocks; every agent's sum must still be the same
-    with either kind of list, and close to the one-block sum (another order of the same terms)."""
+    with either kind of list (the product's claim, bit for bit), and close to the one-block sum
+    (another order of the same terms)."""
     monkeypatch.setattr(lists, "BLOCK", 64)
     a = tmem.simulate(random_swarm(500, axes, True, "all", steps=100))
     b = tmem.simulate(random_swarm(500, axes, True, "verlet", steps=100))
@@ -93,6 +100,7 @@ def test_blocks_keep_verlet_lists_and_all_pairs_equal(monkeypatch, axes):
     np.testing.assert_allclose(b.final_state, one.final_state, rtol=0, atol=1e-12)
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("parts", [1, 3])
 @pytest.mark.parametrize("axes,periodic", [(1, False), (2, False), (2, True), (3, False), (3, True)])
 def test_verlet_pairs_match_brute_force(axes, periodic, parts):
@@ -115,6 +123,7 @@ def test_verlet_pairs_match_brute_force(axes, periodic, parts):
     assert pairs.tolist() == expected.tolist()
 
 
+@pytest.mark.unit
 def test_arrange_drops_formation_pairs_and_cuts_blocks():
     n, block = 10, 4
     pairs = np.array([(i, j) for i in range(n) for j in range(i + 1, n)], dtype=np.uint32)
@@ -221,6 +230,8 @@ def test_uncouple_a_listed_set_of_pairs():
 
 
 def test_recording_a_subset_of_agents():
+    """Recording some agents records their rows of the same run, bit for bit: what is recorded
+    never changes what is computed."""
     s = with_changes(random_swarm(100, 2, True, "auto"), {"simulation.record_agents": [3, 50, 7]})
     tr = tmem.simulate(s)
     full = tmem.simulate(random_swarm(100, 2, True, "auto"))
@@ -229,7 +240,8 @@ def test_recording_a_subset_of_agents():
 
 
 def test_sparse_periodic_swarm_lists_every_neighbour_once():
-    """Few agents in a big periodic box: the cell grid is capped, and must never leave 2 cells round an axis."""
+    """Few agents in a big periodic box: the cell grid is capped, and must never leave 2 cells round an
+    axis; the lists then give the same bits as every pair (the product's claim)."""
     s = from_dict(
         {
             "interaction": {"function": "repulsion"},

@@ -1,12 +1,12 @@
 """Sweep files: how cases are expanded, and the one-line errors for bad files."""
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
+from tmem.cli.main import app
 from tmem.sweep import SweepError, load_sweep, loads_sweep
 from tmem.sweep.spec import SCALAR_METRICS
 
@@ -148,10 +148,8 @@ def test_the_command_refuses_a_bad_sweep_without_traceback_or_output(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(BASE + '[grid]\n"interaction.c_max" = []\n')
     out = tmp_path / "out"
-    result = subprocess.run(
-        [sys.executable, "-m", "tmem", "sweep", str(bad), "--out", str(out)], capture_output=True, text=True
-    )
-    assert result.returncode == 2
+    result = CliRunner().invoke(app, ["sweep", str(bad), "--out", str(out)])  # in-process: no real process needed
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit)  # refused, not raised
     assert "Traceback" not in result.stderr
     lines = [line for line in result.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and "grid.interaction.c_max: is empty" in lines[0]
@@ -165,10 +163,9 @@ def test_the_command_refuses_a_directory_of_another_sweep(tmp_path):
     (out / "results.parquet").write_bytes(b"keep me")
     good = tmp_path / "good.toml"
     good.write_text(BASE + '[grid]\n"interaction.c_max" = [0.1]\n"simulation.duration" = [30.0]\n')
-    result = subprocess.run(
-        [sys.executable, "-m", "tmem", "sweep", str(good), "--out", str(out)], capture_output=True, text=True
-    )
-    assert result.returncode == 2 and "holds the results of a different sweep" in result.stderr
+    result = CliRunner().invoke(app, ["sweep", str(good), "--out", str(out)])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit)
+    assert "holds the results of a different sweep" in result.stderr
     assert "Traceback" not in result.stderr
     assert (out / "results.parquet").read_bytes() == b"keep me"
     assert sorted(p.name for p in out.iterdir()) == ["results.parquet", "sweep.json"]

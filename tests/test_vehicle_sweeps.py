@@ -124,6 +124,7 @@ def test_a_mini_sweep_of_the_hex_on_the_quadrotor_through_dask_equals_direct_run
     assert rows[0]["rms_change_percent"] != rows[1]["rms_change_percent"]  # the delay reached the runs
 
 
+@pytest.mark.physics
 def test_the_error_over_the_last_20_s_agrees_with_the_settling_time():
     """The settled hex stays within SETTLE_BAND of d_t from its settling time on, so over the last
     20 s, once settled before them, its largest error is within the band; over a run no longer than

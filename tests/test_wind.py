@@ -150,6 +150,9 @@ def turbulent_gas(n: int) -> tmem.Scenario:
 
 
 def test_the_gusts_are_the_same_bits_on_threads_and_in_a_swarm_of_another_size(monkeypatch):
+    """The product's claim (docs/vehicles.md), bit for bit: each agent's gusts are drawn from its own
+    stream by the step, so the threaded loop on one and on two threads gives the serial loop's
+    states and body states, and a swarm of 20 agents the first 20 agents' gusts."""
     import numba
 
     from tmem.engine import driver
@@ -204,6 +207,7 @@ WIND_CASES = {
 }
 
 
+@pytest.mark.interface
 @pytest.mark.parametrize("case", WIND_CASES)
 def test_a_bad_wind_table_is_refused_in_one_line(case, tmp_path):
     text, field, reason = WIND_CASES[case]
@@ -216,6 +220,7 @@ def test_a_bad_wind_table_is_refused_in_one_line(case, tmp_path):
     assert "Traceback" not in result.output and not (tmp_path / "out").exists()
 
 
+@pytest.mark.interface
 def test_a_good_wind_table_is_read_back_from_its_toml():
     text = QUADROTOR + '\n[wind]\nvelocity = [1.0]\nvertical = -0.5\n[wind.turbulence]\nseverity = "light"\nseed = 4\n'
     scenario = loads(text)
