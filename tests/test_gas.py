@@ -623,9 +623,9 @@ def test_threads_give_the_serial_bits(monkeypatch):
     product's claim, docs/swarms.md), with every gas option on: walls, an obstacle, the mean of
     pushes and the thermostat; in blocks of 64 agents, summed on threads, with pairs between them.
     (The plain swarm's threaded loop, tests/test_swarm.py, runs with ``-m slow``.)"""
-    from tmem.engine import driver
+    from tmem.engine import driver, lists
 
-    monkeypatch.setattr(driver, "BLOCK", 64)
+    monkeypatch.setattr(lists, "BLOCK", 64)
     scenario = from_dict({
         "name": "threads", "space": {"axes": 2, "walls": True, "box": [700.0, 600.0]},
         "interaction": {"function": "repulsion", "combine": "mean"}, "thermostat": {"rms_velocity": 3.0},
