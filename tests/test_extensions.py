@@ -43,21 +43,17 @@ EXTENSIONS = {
         ("vehicles/drag.py", "", textwrap.dedent('''\
             """A toy vehicle: the linear model (2) with drag on the velocity, V' = g phi - c_d V."""
 
-            from typing import ClassVar, Literal
+            from typing import Literal
 
-            from tmem.scenario.fields import Positive, StrictModel
-            from tmem.vehicles.linear import LinearModel, TiltingGain, state_matrices
+            from tmem.scenario.fields import Positive
+            from tmem.vehicles.linear import LinearModel, LinearModelParams, state_matrices
 
 
-            class DragModelParams(TiltingGain, StrictModel):
-                """The linear model with drag: ``[model] kind = "drag"``."""
+            class DragModelParams(LinearModelParams):
+                """The linear model's table with drag: ``[model] kind = "drag"``."""
 
-                kind: Literal["drag"]
-                kp: Positive = 6.0
-                kd: Positive = 25.0
-                g: Positive = 9.8
+                kind: Literal["drag"] = "drag"
                 c_d: Positive = 0.5
-                max_axes: ClassVar[int] = 3
 
 
             class DragModel(LinearModel):
