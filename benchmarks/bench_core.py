@@ -100,8 +100,12 @@ def child_encounters() -> float:
     """Cases per second of ``run_batch`` on the study's first :data:`ENCOUNTER_DRAWS` starts, both functions."""
     import numpy as np
     from pin_results import sweep_cases
-    from tmem.batch.encounters import run_batch
     from tmem.scenario import with_changes
+
+    try:
+        from tmem.batch.encounters import run_batch
+    except ImportError:  # a tree from before the packages by role: tmem/batch.py
+        from tmem.batch import run_batch
 
     base, points = sweep_cases(STUDY)
     runs = []
