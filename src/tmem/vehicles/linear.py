@@ -104,10 +104,13 @@ def _step(x, body, u, i, scale, params, n_axes):
     ad, bd = params.ad, params.bd
     for a in range(n_axes):
         x0, x1, x2, x3, v = x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3], u[i, a] * scale
-        x[i, a, 0] = ad[0, 0] * x0 + ad[0, 1] * x1 + ad[0, 2] * x2 + ad[0, 3] * x3 + bd[0] * v
-        x[i, a, 1] = ad[1, 0] * x0 + ad[1, 1] * x1 + ad[1, 2] * x2 + ad[1, 3] * x3 + bd[1] * v
-        x[i, a, 2] = ad[2, 0] * x0 + ad[2, 1] * x1 + ad[2, 2] * x2 + ad[2, 3] * x3 + bd[2] * v
-        x[i, a, 3] = ad[3, 0] * x0 + ad[3, 1] * x1 + ad[3, 2] * x2 + ad[3, 3] * x3 + bd[3] * v
+        # All four computed before any is stored: a store into x could otherwise alias ad and bd for
+        # the compiler, which then reads their coefficients again after each one.
+        y0 = ad[0, 0] * x0 + ad[0, 1] * x1 + ad[0, 2] * x2 + ad[0, 3] * x3 + bd[0] * v
+        y1 = ad[1, 0] * x0 + ad[1, 1] * x1 + ad[1, 2] * x2 + ad[1, 3] * x3 + bd[1] * v
+        y2 = ad[2, 0] * x0 + ad[2, 1] * x1 + ad[2, 2] * x2 + ad[2, 3] * x3 + bd[2] * v
+        y3 = ad[3, 0] * x0 + ad[3, 1] * x1 + ad[3, 2] * x2 + ad[3, 3] * x3 + bd[3] * v
+        x[i, a, 0], x[i, a, 1], x[i, a, 2], x[i, a, 3] = y0, y1, y2, y3
 
 
 class TiltingGain:
