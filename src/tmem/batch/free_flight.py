@@ -29,8 +29,11 @@ def level(x, i, a):
     i, a : int
         The row and the axis.
     """
-    for m in range(2, x.shape[2]):
-        if abs(x[i, a, m]) >= (LEVEL_FIRST if m == 2 else LEVEL_REST):
+    n_state = x.shape[2]
+    if n_state > 2 and abs(x[i, a, 2]) >= LEVEL_FIRST:  # apart from the loop below: no test of m in it
+        return False
+    for m in range(3, n_state):
+        if abs(x[i, a, m]) >= LEVEL_REST:
             return False
     return True
 
