@@ -156,7 +156,7 @@ def synchronise(e, i, j, r, dist, entering, pushed, known, pairs, law, params, n
             kept = np.nan
     pairs.kept_speed2[e] = kept
     if not np.isnan(kept):
-        synchronising_push(known, i, j, law.sync_gain, coupled, kept, pushed, params.c_max, n_axes, u)
+        synchronising_push(known, i, j, law.sync_gain, coupled, kept, law.keep_energy, pushed, params.c_max, n_axes, u)
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")

@@ -178,7 +178,7 @@ def formation_pair(k, e, known, agents, pairs, law, params, run, events, counter
             u[j, a] -= d[a]
             pushes[0, a] = pushes[1, a] = 0.0
         if law.sync_gain > 0.0 and not np.isnan(pairs.kept_speed2[e]):
-            synchronising_push(states, 0, 1, law.sync_gain, pairs.flag[e] == 1, pairs.kept_speed2[e], d, params.c_max,
+            synchronising_push(states, 0, 1, law.sync_gain, pairs.flag[e] == 1, pairs.kept_speed2[e], law.keep_energy, d, params.c_max,
                                n_axes, pushes)  # fmt: skip
             for a in range(n_axes):
                 u[j, a] += pushes[1, a]

@@ -48,6 +48,8 @@ class Law(NamedTuple):
         Steps after an uncouple command when the energy-matched uncoupling falls back on (9).
     sync_gain : float
         ``k_s`` of the speed synchronisation (S2) (rad per m/s); 0: none.
+    keep_energy : bool
+        Whether (S2) holds each pair's mean square speed (S3), or only damps its relative motion.
 
     The interaction functions' parameters travel beside it, as their own
     record (:class:`~tmem.law.interaction.kernels.FunctionParams`: the law's ``K_P``,
@@ -65,11 +67,12 @@ class Law(NamedTuple):
     energy_tolerance: float
     fallback_steps: int
     sync_gain: float
+    keep_energy: bool
 
 
 #: The fields of :class:`Law` taken as they are from :class:`~tmem.law.params.LawParams` (the others are
 #: derived from it: codes for names, flags for choices).
-_COPIED = tuple(name for name in Law._fields if name in LawParams.model_fields and name != "function")
+_COPIED = tuple(name for name in Law._fields if name in LawParams.model_fields and name not in ("function", "keep_energy"))
 
 
 def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gains: np.ndarray) -> tuple[Law, FunctionParams]:
@@ -95,10 +98,11 @@ def law_of(scenario: Scenario, linearisation: tuple[np.ndarray, np.ndarray], gai
     sync_gain = synchronising_gain(*linearisation, gains, ia.sync_damping) if ia.synchronise else 0.0
     slow = coupled_mode(*linearisation, gains, sync_gain)
     period = 2.0 * np.pi / abs(slow.imag) if slow.imag != 0.0 else 1.0 / abs(slow.real)
-    return law_record(ia, gains, scenario.simulation.step_of(period), sync_gain)
+    return law_record(ia, gains, scenario.simulation.step_of(period), sync_gain, scenario.keeps_energy)
 
 
-def law_record(params: LawParams, gains: np.ndarray, fallback_steps: int, sync_gain: float) -> tuple[Law, FunctionParams]:
+def law_record(params: LawParams, gains: np.ndarray, fallback_steps: int, sync_gain: float,
+               keep_energy: bool = True) -> tuple[Law, FunctionParams]:  # fmt: skip
     """The :class:`Law` of agents that share the gains ``gains``, and the interaction functions'
     parameters, from the law's parameters (:class:`tmem.law.params.LawParams`: a scenario's
     ``[interaction]`` table or a controller's :class:`~tmem.law.params.ControllerLaw`), by name.
@@ -113,6 +117,8 @@ def law_record(params: LawParams, gains: np.ndarray, fallback_steps: int, sync_g
         Steps after an uncouple command when the energy rule falls back on (9).
     sync_gain : float
         ``k_s`` of (S2); 0: no synchronisation.
+    keep_energy : bool
+        Whether (S2) holds the pairs' mean square speed (S3) (:attr:`Scenario.keeps_energy`).
     """
     couples = uses_coupling(params.function)
     law = Law(
@@ -124,6 +130,7 @@ def law_record(params: LawParams, gains: np.ndarray, fallback_steps: int, sync_g
         uncouple_rule=coupling.UNCOUPLE_RULES.index(params.uncouple_when),
         fallback_steps=fallback_steps,
         sync_gain=sync_gain,
+        keep_energy=keep_energy,
         **{name: getattr(params, name) for name in _COPIED},  # numbers of the law, as named there
     )
     kernels = {name: getattr(params, name) for name in FunctionParams._fields if name != "k_p"}  # reach, d_t, c_max ...

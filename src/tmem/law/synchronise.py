@@ -146,7 +146,7 @@ def mean_square_speed(known, i, j, n_axes):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def synchronising_push(known, i, j, k_s, damped, kept, pushed, c_max, n_axes, u):
+def synchronising_push(known, i, j, k_s, damped, kept, keeps, pushed, c_max, n_axes, u):
     """Add (S2) of the pair ``(i, j)`` to the set-points ``u`` of both agents.
 
     Parameters
@@ -160,6 +160,9 @@ def synchronising_push(known, i, j, k_s, damped, kept, pushed, c_max, n_axes, u)
         holds ``E`` at ``E*`` (S3).
     kept : float
         ``E*``, the mean square speed the pair holds (m^2/s^2).
+    keeps : bool
+        Whether the common push holds ``E`` at ``E*`` (S3); without, the relative motion is only damped
+        (where an agent term steers the group's mean motion, :data:`tmem.terms.base.AgentTerm.steers_group`).
     pushed : ndarray, shape (axes,)
         The pair's own push on agent ``i`` this step (``-pushed`` on ``j``; rad).
     c_max : float
@@ -179,7 +182,7 @@ def synchronising_push(known, i, j, k_s, damped, kept, pushed, c_max, n_axes, u)
     damping = k_s if damped else 0.0
     speed = np.sqrt(common2)
     energy = common2 + 0.25 * relative2
-    push = (k_s * (kept - energy) + 0.5 * (work + damping * relative2)) / speed if speed > 0.0 else 0.0  # u_c
+    push = (k_s * (kept - energy) + 0.5 * (work + damping * relative2)) / speed if speed > 0.0 and keeps else 0.0  # u_c
     scale = min(1.0, 0.5 * c_max / abs(push)) if push != 0.0 else 1.0
     along = scale * push / speed if speed > 0.0 else 0.0  # u_c / |V_c|: times V_c gives u_c c
     for a in range(n_axes):

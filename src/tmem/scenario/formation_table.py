@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Annotated, Literal
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from tmem.law.interaction.registry import uses_coupling
@@ -29,6 +30,8 @@ class FormationParams(StrictModel):
     jitter: NonNegative = 0.0
     seed: Annotated[int, Field(ge=0)] = 0
     coupled: bool = True
+    scatter: list[Positive] | None = None
+    min_spacing: Positive | None = None
 
     @model_validator(mode="after")
     def _kind_needs(self) -> "FormationParams":
@@ -47,6 +50,15 @@ class FormationParams(StrictModel):
                 raise FieldError("n", f"is required for kind = {self.kind!r}")
             if self.kind == "ring" and self.n is not None and self.n < 3:
                 raise FieldError("n", f"a ring needs at least 3 agents, got {self.n}")
+        if self.scatter is not None:
+            if self.kind == "edges":
+                raise FieldError("scatter", 'is for a generated shape, not kind = "edges"')
+            if self.jitter > 0.0 or self.coupled:
+                raise FieldError("scatter", "scattered agents start uncoupled and unjittered: set coupled = false, jitter = 0")
+            if self.min_spacing is None:
+                raise FieldError("min_spacing", "is required with scatter: the least distance between two starts (m)")
+        elif self.min_spacing is not None:
+            raise FieldError("min_spacing", "is for scattered starts: give scatter too")
         return self
 
 
@@ -72,10 +84,17 @@ def check_formation(scenario: Scenario, axes: int, n: int) -> None:
     d_t = f.d_t or scenario.interaction.d_t
     if d_t >= scenario.interaction.reach:
         raise FieldError("formation.d_t", f"must be less than R + R_j = {scenario.interaction.reach:g} m, got {d_t:g}")
-    for name in ("center", "velocity"):
+    for name in ("center", "velocity", "scatter"):
         value = getattr(f, name)
         if value is not None and len(value) != axes:
             raise FieldError(f"formation.{name}", per_axis(axes, len(value)))
+    if f.scatter is not None:
+        from tmem.plan.starts import spaced_points
+
+        try:  # the draw itself: the starts a run takes, or the one line that says why they cannot be drawn
+            spaced_points(n, np.zeros(axes), np.asarray(f.scatter, dtype=float), f.min_spacing, f.seed)
+        except ValueError as error:
+            raise FieldError("formation.min_spacing", str(error)) from None
     if f.kind == "edges":
         seen = set()
         for k, edge in enumerate(f.edges):

@@ -133,6 +133,14 @@ class _Scenario(StrictModel):
         return tuple(name for name in TERMS if getattr(self, name) is not None)
 
     @property
+    def keeps_energy(self) -> bool:
+        """Whether the speed synchronisation holds each pair's mean square speed (S3): ``interaction.keep_energy``,
+        by default unless an agent term steers the group's mean motion (:attr:`tmem.terms.base.AgentTerm.steers_group`)."""
+        if self.interaction.keep_energy is not None:
+            return self.interaction.keep_energy
+        return not any(term_class(name).steers_group for name in self.agent_terms)
+
+    @property
     def position_gain(self) -> float:
         """``K_P`` of the law (rad/m): the modal gain on position that places the roots (5) (:func:`tmem.law.modal.modal_gains`)."""
         c = self.controller

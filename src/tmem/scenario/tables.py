@@ -71,11 +71,14 @@ class InteractionParams(LawParams):
     energy into its common motion (:mod:`tmem.law.synchronise`).  ``combine``: an agent's pushes of
     several neighbours are summed (``"sum"``, the paper's reading) or averaged over the neighbours,
     walls and obstacles within reach (``"mean"``, which keeps each agent's loop ``A - B K`` in
-    crowds: :mod:`tmem.engine.gas`).
+    crowds: :mod:`tmem.engine.gas`).  ``keep_energy``: whether the synchronisation holds each pair's
+    mean square speed (S3); by default it does, except where an agent term steers the group's mean
+    motion (a ``[navigation]`` mission), whose changes of speed (S3) would undo.
     """
 
     radius: Positive = 20.0
     synchronise: bool = False
+    keep_energy: bool | None = None
     sync_damping: Annotated[float, Field(gt=0, lt=1)] = 0.7
     combine: Literal["sum", "mean"] = "sum"
 

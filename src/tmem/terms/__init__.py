@@ -19,6 +19,7 @@ from functools import cache
 #: The agent terms, ``scenario table -> "module:Class"``, in the order their pushes are added.
 TERMS: dict[str, str] = {
     "pull": "tmem.terms.pull:Pull",
+    "navigation": "tmem.terms.navigation:Navigation",
 }
 
 

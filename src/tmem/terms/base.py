@@ -20,7 +20,10 @@ A term provides, as class attributes and methods (:mod:`tmem.terms.pull` is a wo
 * :attr:`AgentTerm.rebuilt` — the fields of its record a checkpoint does not hold (numbers fixed for
   the run, work space), each with the reason it is made again exactly; every other field is saved;
 * :attr:`AgentTerm.local` — whether it reads the agent's own state only, so that a per-agent
-  controller (:mod:`tmem.agent`) could run it.
+  controller (:mod:`tmem.agent`) could run it;
+* :attr:`AgentTerm.steers_group` — whether it sets the group's mean motion (a mission): the speed
+  synchronisation (S2) then damps the pairs' relative motion without holding their mean square
+  speed (S3), which would fight every change of speed the term asks for (``interaction.keep_energy``).
 """
 
 from __future__ import annotations
@@ -39,6 +42,8 @@ class AgentTerm:
     rebuilt: ClassVar[dict[str, str]] = {}
     #: Whether the term reads the agent's own state only.
     local: ClassVar[bool] = True
+    #: Whether the term sets the group's mean motion (module text).
+    steers_group: ClassVar[bool] = False
 
     @classmethod
     def record(cls, settings: Any, scenario: Any, gains: Any) -> NamedTuple:

@@ -91,6 +91,20 @@ def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
     return state[np.lexsort(cells.T)]
 
 
+def _scattered(places: np.ndarray, f, axes: int) -> np.ndarray:
+    """Starts at random in the region ``scatter`` centred on the formation, ``min_spacing`` apart
+    (Poisson-disk sampling), each given to the agent whose place CAPT assigns it: the sum of the
+    squared distances from start to place is the least (Turpin et al. 2014, :mod:`tmem.plan.assignment`)."""
+    from tmem.plan.assignment import assign
+    from tmem.plan.starts import spaced_points
+
+    centre, half = _vector(f.center or 0.0, axes), 0.5 * _vector(f.scatter, axes)
+    starts = spaced_points(len(places), centre - half, centre + half, f.min_spacing, f.seed)
+    scattered = np.empty_like(places)
+    scattered[assign(starts, places)] = starts
+    return scattered
+
+
 def _near_obstacle(positions: np.ndarray, obstacles, reach: float) -> np.ndarray:
     """Whether each position lies within ``reach`` of an obstacle (or inside it)."""
     near = np.zeros(len(positions), dtype=bool)
@@ -121,6 +135,8 @@ def build(scenario: Scenario) -> InitialArrays:
         state = np.zeros((n, axes, 4))
         state[:, :, 0] = shape.positions + _vector(f.center or 0.0, axes)
         state[:, :, 0] += rng.uniform(-f.jitter, f.jitter, (n, axes)) if f.jitter > 0 else 0.0
+        if f.scatter is not None:
+            state[:, :, 0] = _scattered(state[:, :, 0], f, axes)
         state[:, :, 1] = _vector(f.velocity or 0.0, axes)
         direction = shape.direction
     else:

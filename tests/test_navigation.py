@@ -1,0 +1,142 @@
+"""Group navigation (N1)-(N4): a rigid formation stays rigid, the centre moves as one agent does.
+
+The references are independent of the term's code: the relative states of a perfect formation
+(zero, for a common-mode push), the closed loop of the centre's velocity written here from the
+model (2) and scipy's ``expm``, the loop's roots from ``numpy.linalg.eigvals``, and the mission's
+goal.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+import tmem
+from tmem.scenario import ScenarioError, with_changes
+from tmem.terms.navigation import loop_gains
+
+HEX = """
+name = "hex7-mission"
+[space]
+axes = 2
+[interaction]
+function = "improved"
+synchronise = true
+d_t = 35.0
+[formation]
+kind = "hex"
+n = 7
+velocity = [0.0, 0.0]
+jitter = 0.0
+[navigation]
+bandwidth = 0.5
+[[navigation.legs]]
+time = 0.0
+action = "velocity"
+velocity = [2.0, 1.0]
+[[navigation.legs]]
+time = 30.0
+action = "route"
+waypoints = [[150.0, 0.0], [150.0, 120.0]]
+speed = 4.0
+[simulation]
+dt = 0.001
+duration = 150.0
+record_every = 200
+"""
+
+
+@pytest.fixture(scope="module")
+def flown():
+    scenario = tmem.loads(HEX)
+    return scenario, tmem.simulate(scenario)
+
+
+def test_a_perfect_formation_told_to_move_and_turn_keeps_zero_strain(flown):
+    """A common-mode push leaves every relative state where it was: all agents share one velocity."""
+    scenario, trajectory = flown
+    v = trajectory.state[:, :, :, 1]  # (time, agent, axis)
+    assert np.ptp(v, axis=1).max() < 1e-9
+    assert np.abs(trajectory.pair_distance - 35.0).max() < 1e-8
+    speed = np.linalg.norm(v[:, 0], axis=-1)
+    assert speed.max() > 3.5  # it did fly: the test could fail
+
+
+def test_the_group_arrives_at_the_end_of_its_route(flown):
+    scenario, trajectory = flown
+    centre = trajectory.state[-1, :, :, 0].mean(axis=0)
+    assert np.linalg.norm(centre - [150.0, 120.0]) < 0.05
+    assert np.abs(trajectory.state[-1, :, :, 1]).max() < 0.01
+
+
+def test_the_centre_follows_the_closed_loop_of_one_agent_under_the_velocity_loop(flown):
+    """During the velocity leg (no saturation after the first seconds), the centre's velocity against
+    the exact zero-order hold of ``A_s - B_s K_n`` written here, started from the recorded state."""
+    scenario, trajectory = flown
+    m = scenario.model
+    a = np.array([[0, m.g, 0], [0, 0, 1], [0, -m.kp * m.kd, -m.kd]], dtype=float)  # (V, phi, omega)
+    b = np.array([0, 0, m.kp * m.kd], dtype=float)
+    k = loop_gains(scenario, 0.5)
+    closed = a - np.outer(b, k)
+    dt = scenario.simulation.dt * scenario.simulation.record_every
+    start, stop = int(10.0 / dt), int(29.0 / dt)
+    centre = trajectory.state[:, :, :, 1:4].mean(axis=1)  # (time, axis, 3)
+    wanted = np.array([2.0, 1.0])
+    x = centre[start] - np.stack([wanted, [0, 0], [0, 0]], axis=1)
+    step = expm(closed * dt)
+    for n in range(start + 1, stop):
+        x = x @ step.T
+        np.testing.assert_allclose(centre[n, :, 0], x[:, 0] + wanted, atol=2e-4)
+
+
+def test_the_velocity_loop_has_the_roots_it_is_placed_at():
+    scenario = tmem.loads(HEX)
+    m = scenario.model
+    a = np.array([[0, m.g, 0], [0, 0, 1], [0, -m.kp * m.kd, -m.kd]], dtype=float)
+    b = np.array([0, 0, m.kp * m.kd], dtype=float)
+    for bandwidth in (0.1, 0.5, 2.0):
+        roots = np.sort_complex(np.linalg.eigvals(a - np.outer(b, loop_gains(scenario, bandwidth))))
+        np.testing.assert_allclose(roots, np.sort_complex([-12 - 0.1j, -12 + 0.1j, -bandwidth]), atol=1e-9)
+
+
+def test_a_mission_damps_the_pairs_without_holding_their_energy_unless_told():
+    scenario = tmem.loads(HEX)
+    assert not scenario.keeps_energy
+    assert with_changes(scenario, {"interaction.keep_energy": True}).keeps_energy
+    assert with_changes(scenario, {"navigation": None}).keeps_energy
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"navigation.bandwidth": 3.5}, r"navigation\.bandwidth: 3\.5 /s is above a quarter of the law's slowest damped root, 12 /s"),
+    ({"navigation.share": 1.0}, r"navigation\.share: must be below 1"),
+    ({"navigation.legs": []}, r"navigation\.legs: is empty"),
+    ({"navigation.legs": [{"time": 0.0, "action": "goto", "target": [1.0, 2.0]}]}, r"navigation\.legs\[0\]\.speed: is required for goto"),
+    ({"navigation.legs": [{"time": 0.0, "action": "goto", "target": [1.0], "speed": 2.0}]}, r"navigation\.legs\[0\]\.target: needs 2 values"),
+    ({"navigation.legs": [{"time": 0.0, "action": "hold", "speed": 2.0}]}, r"navigation\.legs\[0\]\.speed: is not used by hold"),
+    ({"navigation.legs": [{"time": 0.0, "action": "route", "waypoints": [[1.0, 2.0]], "speed": [1.0, 2.0]}]},
+     r"navigation\.legs\[0\]\.speed: gives 2 speeds for 1 waypoints"),
+    ({"navigation.legs": [{"time": 0.0, "action": "goto", "target": [1.0, 2.0], "speed": 2.0, "avoid": True}]},
+     r"navigation\.legs\[0\]\.avoid: has no \[\[obstacles\]\] to plan around"),
+    ({"navigation.legs": [{"time": 5.0, "action": "hold"}, {"time": 5.0, "action": "hold"}]},
+     r"navigation\.legs\[1\]\.time: must come after the leg before \(5 s\)"),
+    ({"navigation.legs": [{"time": 500.0, "action": "hold"}]}, r"navigation\.legs\[0\]\.time: must not be later than duration = 150 s"),
+])  # fmt: skip
+def test_a_bad_mission_is_refused_in_one_line_naming_the_key(change, message):
+    scenario = tmem.loads(HEX)
+    with pytest.raises(ScenarioError, match=message):
+        with_changes(scenario, change)
+
+
+def test_a_mission_goes_on_from_its_checkpoint_to_the_same_bits(tmp_path):
+    """Each agent's leg, waypoint and hold point are saved (the route turns after the checkpoint)."""
+    from test_checkpoint import assert_same_bits, stopped_after
+
+    from tmem.engine.checkpoint import Checkpoints
+
+    scenario = with_changes(tmem.loads(HEX), {"simulation.duration": 70.0})
+    reference = tmem.simulate(scenario)
+    saved = stopped_after(scenario, tmp_path / "run.npz", 35.0, 40.0)
+    assert {"terms.navigation.leg_now", "terms.navigation.point_now", "terms.navigation.leg_from"} <= set(saved.arrays)
+    resumed = tmem.simulate(scenario, checkpoints=Checkpoints(tmp_path / "run.npz", 35.0))
+    assert_same_bits(reference, resumed)
