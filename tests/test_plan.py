@@ -12,6 +12,8 @@ from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
 from tmem.plan import assignment as capt
+from tmem.plan import shapes
+from tmem.world import formation
 
 # --- assignment (CAPT) ---------------------------------------------------------------------------
 
@@ -138,3 +140,76 @@ def test_capt_safe_tests_the_separation():
     assert capt.capt_safe(starts, goals, 0.71) is False  # 2.008 > 2 (the goals)
     with pytest.raises(ValueError, match="2 starts cannot go to 1 goals"):
         capt.capt_safe(starts, goals[:1], 0.0)
+
+
+# --- shapes -------------------------------------------------------------------------------------
+
+
+def _nearest(offsets: np.ndarray) -> np.ndarray:
+    """Each slot's distance to its nearest other slot."""
+    distance = cdist(offsets, offsets)
+    np.fill_diagonal(distance, np.inf)
+    return distance.min(axis=1)
+
+
+def _brute_edges(offsets: np.ndarray, spacing: float) -> set[tuple[int, int]]:
+    distance = cdist(offsets, offsets)
+    return {(i, j) for i, j in zip(*np.nonzero(np.isclose(distance, spacing, rtol=1e-9, atol=0))) if i < j}
+
+
+@pytest.mark.parametrize("rings, count, edges", [(0, 1, 0), (1, 7, 12), (2, 19, 42), (3, 37, 90), (4, 61, 156)])
+def test_full_hexagons_have_their_counts_and_edges(rings, count, edges):
+    slots = shapes.hex_slots(rings=rings, spacing=2.5)
+    assert shapes.hex_count(rings) == count and slots.offsets.shape == (count, 2)
+    assert len(slots.edges) == edges == 3 * rings * (3 * rings + 1)
+    if count > 1:
+        np.testing.assert_allclose(_nearest(slots.offsets), 2.5, rtol=1e-12)
+    np.testing.assert_allclose(slots.offsets.mean(axis=0), 0.0, atol=1e-12)
+    assert set(map(tuple, slots.edges.tolist())) == _brute_edges(slots.offsets, 2.5)
+    same = shapes.hex_slots(count, 2.5)
+    np.testing.assert_array_equal(same.offsets, slots.offsets)
+    np.testing.assert_array_equal(same.edges, slots.edges)
+
+
+def test_hex_slots_are_the_formation_patch_and_its_lattice_edges():
+    for n in (5, 19, 30):
+        patch, slots = formation.hex_patch(n, 3.0, 3), shapes.hex_slots(n, 3.0, axes=3)
+        np.testing.assert_array_equal(slots.offsets, patch.positions)
+        np.testing.assert_array_equal(slots.edges, patch.edges)
+    with pytest.raises(ValueError, match="either n"):
+        shapes.hex_slots(7, 1.0, rings=1)
+    with pytest.raises(ValueError, match="spacing must be"):
+        shapes.hex_slots(7, 0.0)
+
+
+@pytest.mark.parametrize("heading", [0.0, 0.3, math.pi / 2, 2.0])
+def test_line_slots_lie_along_the_heading(heading):
+    slots = shapes.line_slots(6, 4.0, heading)
+    assert slots.offsets.shape == (6, 2) and len(slots.edges) == 5
+    np.testing.assert_array_equal(slots.edges, [[k, k + 1] for k in range(5)])
+    steps = np.diff(slots.offsets, axis=0)
+    np.testing.assert_allclose(steps, np.tile([4 * math.cos(heading), 4 * math.sin(heading)], (5, 1)), atol=1e-12)
+    np.testing.assert_allclose(slots.offsets.mean(axis=0), 0.0, atol=1e-12)
+    assert shapes.line_slots(1, 4.0).edges.shape == (0, 2)
+
+
+@pytest.mark.parametrize("n", [3, 4, 5, 8, 13])
+def test_ring_slots_are_a_polygon_of_side_spacing(n):
+    slots = shapes.ring_slots(n, 5.0, axes=3)
+    assert slots.offsets.shape == (n, 3) and len(slots.edges) == n
+    np.testing.assert_allclose(_nearest(slots.offsets), 5.0, rtol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(slots.offsets, axis=1), 5.0 / (2 * math.sin(math.pi / n)), rtol=1e-12)
+    assert set(map(tuple, slots.edges.tolist())) == _brute_edges(slots.offsets, 5.0)
+
+
+@pytest.mark.parametrize("rows, cols", [(1, 1), (1, 5), (3, 4), (6, 6)])
+def test_grid_slots_count_spacing_and_edges(rows, cols):
+    slots = shapes.grid_slots(rows, cols, 1.5)
+    assert slots.offsets.shape == (rows * cols, 2)
+    assert len(slots.edges) == 2 * rows * cols - rows - cols
+    if rows * cols > 1:
+        np.testing.assert_allclose(_nearest(slots.offsets), 1.5, rtol=1e-12)
+    np.testing.assert_allclose(slots.offsets.mean(axis=0), 0.0, atol=1e-12)
+    assert set(map(tuple, slots.edges.tolist())) == _brute_edges(slots.offsets, 1.5)
+    with pytest.raises(ValueError, match="rows must be an integer >= 1"):
+        shapes.grid_slots(0, cols, 1.5)
