@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
-from scipy.spatial.distance import cdist
+from scipy.spatial.distance import cdist, pdist
 
 from tmem.plan import assignment as capt
-from tmem.plan import route, shapes
+from tmem.plan import route, shapes, starts
 from tmem.world import formation
 
 # --- assignment (CAPT) ---------------------------------------------------------------------------
@@ -334,3 +334,59 @@ def test_route_refuses_a_start_or_goal_inside_an_obstacle_and_a_closed_way():
     ring = 100.0 * np.stack([np.cos(angle), np.sin(angle)], axis=1)  # a closed fence of discs about the start
     with pytest.raises(ValueError, match="no route from start to goal keeps 2 m from the obstacles"):
         route.plan_route([0.0, 0.0], [300.0, 0.0], ring, np.full(24, 20.0), 2.0)
+
+
+# --- spaced random starts -----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bounded", [True, False])
+@pytest.mark.parametrize(
+    "lower, upper, spacing",
+    [([0.0, 0.0], [300.0, 1000.0], 30.0), ([-5.0, 10.0, 0.0], [45.0, 40.0, 20.0], 6.0), ([2.0], [80.0], 3.0)],
+)
+def test_the_poisson_fill_keeps_the_spacing_in_metres_on_either_path(lower, upper, spacing, bounded):
+    """Both ways of sampling (the box itself, SciPy >= 1.15; the unit cube scaled) keep the spacing and the box."""
+    points = starts._fill(np.array(lower), np.array(upper), spacing, np.random.default_rng(5), bounded)
+    assert pdist(points).min() >= spacing
+    assert np.all(points >= lower) and np.all(points <= upper)
+    reach = 2 * spacing  # spread over the whole box: no side left empty
+    assert np.all(points.min(axis=0) <= np.add(lower, reach)) and np.all(points.max(axis=0) >= np.subtract(upper, reach))
+
+
+def test_spaced_points_are_spaced_inside_and_reproducible(monkeypatch):
+    lower, upper = [0.0, 0.0], [300.0, 1000.0]
+    points = starts.spaced_points(150, lower, upper, 25.0, seed=9)
+    assert points.shape == (150, 2)
+    assert pdist(points).min() >= 25.0
+    assert np.all(points >= lower) and np.all(points <= upper)
+    np.testing.assert_array_equal(points, starts.spaced_points(150, lower, upper, 25.0, seed=9))
+    assert not np.array_equal(points, starts.spaced_points(150, lower, upper, 25.0, seed=10))
+    monkeypatch.setattr(starts, "_bounded", lambda: False)  # the path of SciPy < 1.15
+    older = starts.spaced_points(150, lower, upper, 25.0, seed=9)
+    assert pdist(older).min() >= 25.0 and np.all(older >= lower) and np.all(older <= upper)
+    assert starts.spaced_points(0, lower, upper, 25.0).shape == (0, 2)
+
+
+def test_the_packing_bound_is_oler_and_admits_the_tight_packings():
+    assert starts.packing_bound([0, 0], [1, 1], 1.0) == 4  # the square's corners
+    assert starts.packing_bound([0, 0], [2, 2], 1.0) == 9  # a 3 x 3 grid
+    assert starts.packing_bound([0], [10], 2.5) == 5
+    assert starts.packing_bound([0, 0, 0], [1, 1, 1], 1.0) == 11  # sqrt 2 * 8 = 11.3 (8 corners fit)
+    hexagon = shapes.hex_slots(rings=4, spacing=10.0).offsets  # 61 points 10 m apart
+    assert starts.packing_bound(hexagon.min(axis=0), hexagon.max(axis=0), 10.0) >= 61
+    area = 300.0 * 1000.0
+    assert starts.packing_bound([0, 0], [300, 1000], 20.0) == math.floor(area / (math.sqrt(3) / 2 * 400) + 1300 / 20 + 1)
+
+
+def test_spaced_points_refuse_what_cannot_fit():
+    most = starts.packing_bound([0, 0], [100, 100], 10.0)
+    assert most == math.floor(2 / math.sqrt(3) * 100 + 20 + 1)  # 136
+    refusal = rf"^{most + 1} points cannot be 10 m apart in \[0, 100\] x \[0, 100\] m: at most {most} fit \(Oler bound\)$"
+    with pytest.raises(ValueError, match=refusal):
+        starts.spaced_points(most + 1, [0, 0], [100, 100], 10.0, seed=1)
+    with pytest.raises(ValueError, match=r"^Poisson-disk sampling placed only \d+ points 10 m apart .* fewer than n = 130"):
+        starts.spaced_points(130, [0, 0], [100, 100], 10.0, seed=1)  # under the bound, past a random sample
+    with pytest.raises(ValueError, match="min_spacing must be"):
+        starts.spaced_points(3, [0, 0], [100, 100], -1.0)
+    with pytest.raises(ValueError, match="upper > lower"):
+        starts.spaced_points(3, [0, 0], [100, 0], 1.0)
