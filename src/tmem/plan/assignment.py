@@ -1,16 +1,16 @@
 """CAPT: the assignment of starts to goals, and the synchronised straight-line trajectories.
 
-Concurrent assignment and planning of trajectories (CAPT; Turpin, Michael and Kumar 2014) for
+Concurrent assignment and planning of trajectories (CAPT; Turpin, Michael and Kumar 2014 [1]_) for
 agents of equal radius ``R`` in open space:
 
 1. **Assignment.**  Start ``i`` goes to goal ``phi(i)``, the one-to-one map that minimises the sum
-   of squared distances ``sum_i |g_phi(i) - s_i|^2`` (the paper's eq. (5) with ``p = 2``), solved as a
-   linear assignment problem (:func:`scipy.optimize.linear_sum_assignment`, Crouse 2016).  There may
+   of squared distances ``sum_i |g_phi(i) - s_i|^2`` (the paper's cost, the squared distances), solved as a
+   linear assignment problem (:func:`scipy.optimize.linear_sum_assignment`, Crouse 2016 [2]_).  There may
    be more goals than starts (``N <= M``); the unused goals stay empty.
 2. **Trajectories.**  Every agent flies the straight line to its goal on the same clock,
    ``x_i(t) = (1 - beta(t)) s_i + beta(t) g_phi(i)``, where ``beta`` rises from 0 to 1 over
    ``[0, T]`` with zero velocity at both ends (:data:`PROFILES`).
-3. **Guarantee** (the paper's Theorem 2 under its Assumption 1).  If every two starts and every two
+3. **Guarantee** (the paper's safety theorem for centralised CAPT).  If every two starts and every two
    goals are more than ``2 sqrt(2) R`` apart, every two agents stay more than ``2 R`` apart all the
    way.  Why, in two lines: the optimal assignment cannot be improved by swapping two goals, so
    ``a . c >= 0`` for ``a = s_i - s_j`` and ``c = g_phi(i) - g_phi(j)``; then
@@ -39,7 +39,7 @@ __all__ = ["PROFILES", "assign", "assignment_cost", "capt_clearance", "capt_dura
 
 #: The time scalings ``beta(tau)``, ``tau = t / T`` in [0, 1], with beta(0) = 0, beta(1) = 1 and
 #: beta'(0) = beta'(1) = 0: each row is (coefficients of beta in powers of tau from tau^0,
-#: max |d beta / d tau|, max |d^2 beta / d tau^2|).  ``"cubic"``: 3 tau^2 - 2 tau^3, peak slope
+#: the largest ``|d beta / d tau|``, the largest ``|d^2 beta / d tau^2|``).  ``"cubic"``: 3 tau^2 - 2 tau^3, peak slope
 #: 3/2 at tau = 1/2, peak curvature 6 at both ends (the acceleration jumps at start and end).
 #: ``"quintic"``: 10 tau^3 - 15 tau^4 + 6 tau^5 (zero acceleration at both ends too), peak slope
 #: 15/8 at tau = 1/2, peak curvature 10/sqrt(3) at tau = 1/2 -+ sqrt(3)/6.
@@ -83,7 +83,7 @@ def _profile(profile: str) -> tuple[tuple[float, ...], float, float]:
 
 
 def assign(starts: object, goals: object) -> np.ndarray:
-    """The goal of each start that minimises the sum of squared distances (CAPT's assignment [1]_).
+    """The goal of each start that minimises the sum of squared distances (CAPT's assignment).
 
     Parameters
     ----------
@@ -100,7 +100,7 @@ def assign(starts: object, goals: object) -> np.ndarray:
     Notes
     -----
     The cost matrix is dense, ``N x M`` float64: 800 MB for 10^4 agents.  Solved by
-    :func:`scipy.optimize.linear_sum_assignment` (shortest augmenting paths, Crouse [2]_).
+    :func:`scipy.optimize.linear_sum_assignment` (shortest augmenting paths, Crouse 2016).
     """
     from scipy.optimize import linear_sum_assignment
     from scipy.spatial.distance import cdist
@@ -134,7 +134,7 @@ def capt_trajectory(
     """Places and velocities on CAPT's synchronised straight lines at times ``t``.
 
     ``x_i(t) = (1 - beta) s_i + beta g_i`` and ``v_i(t) = (beta' / T) (g_i - s_i)``, with
-    ``beta = beta(t / T)`` from :data:`PROFILES` ([1]_, Section 4); before 0 the agents wait at
+    ``beta = beta(t / T)`` from :data:`PROFILES` (Turpin et al. 2014); before 0 the agents wait at
     their starts, after ``T`` at their goals.
 
     Parameters
@@ -261,8 +261,9 @@ def _nearest_gap(points: np.ndarray) -> float:
 def capt_safe(starts: object, goals: object, radius: float) -> bool:
     """Whether CAPT's guarantee holds: every two starts and every two goals more than ``2 sqrt(2) R`` apart.
 
-    Under that separation (Assumption 1 of [1]_) the optimal assignment's trajectories keep every
-    two agents more than ``2 R`` apart (Theorem 2 of [1]_; the module text gives the argument).
+    Under that separation (the assumption of Turpin et al. 2014's safety theorem for centralised
+    CAPT) the optimal assignment's trajectories keep every two agents more than ``2 R`` apart (the
+    module text gives the argument).
     All goals count, used or not.
 
     Parameters

@@ -3,7 +3,7 @@
 The group (its formation's circumradius plus a margin) is to keep ``clearance`` from every obstacle
 ``k`` (a disc of centre ``c_k`` and radius ``r_k``), i.e. its route's centre line stays outside
 the *inflated* discs of radius ``rho_k = r_k + clearance`` (the configuration-space obstacles of a
-disc robot, Lozano-Perez and Wesley 1979 [1]_).
+disc robot: Lozano-Perez and Wesley 1979 [1]_).
 
 Each inflated disc is replaced by its circumscribed regular ``m``-gon (vertex radius
 ``rho_k / cos(pi / m)``, so the polygon contains the disc and its sides touch it).  The graph's

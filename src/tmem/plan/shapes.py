@@ -10,7 +10,7 @@ from :mod:`tmem.world.formation` (:func:`~tmem.world.formation.hex_patch`,
 :func:`~tmem.world.formation.chain`, :func:`~tmem.world.formation.ring`); the line is turned to a
 heading here, and the rectangular grid is added.
 
-* hexagonal patch: the triangular lattice's points nearest the centre; full hexagons of ``k``
+* hexagonal patch: the triangular (hexagonal) lattice's points nearest the centre [1]_; full hexagons of ``k``
   rings hold ``3 k (k + 1) + 1`` = 1, 7, 19, 37, 61 ... slots and ``3 k (3 k + 1)`` edges (0, 12,
   42, 90, 156 ...: each of the ``3 k (k - 1) + 1`` inner slots has six neighbours, and the hexagon's
   ``6 k`` boundary slots share ``6 k`` boundary edges);
