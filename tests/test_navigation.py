@@ -140,3 +140,58 @@ def test_a_mission_goes_on_from_its_checkpoint_to_the_same_bits(tmp_path):
     assert {"terms.navigation.leg_now", "terms.navigation.point_now", "terms.navigation.leg_from"} <= set(saved.arrays)
     resumed = tmem.simulate(scenario, checkpoints=Checkpoints(tmp_path / "run.npz", 35.0))
     assert_same_bits(reference, resumed)
+
+
+SCATTERED = """
+name = "hex7-assembly"
+[space]
+axes = 2
+[interaction]
+function = "improved"
+synchronise = true
+d_t = 35.0
+[formation]
+kind = "hex"
+n = 7
+center = [10.0, -20.0]
+scatter = [300.0, 300.0]
+min_spacing = 30.0
+seed = 1
+[navigation]
+[[navigation.legs]]
+time = 0.0
+action = "assemble"
+speed = 5.0
+[simulation]
+dt = 0.001
+duration = 150.0
+record_every = 500
+"""
+
+
+def test_scattered_agents_start_at_the_places_capt_gives_them_the_least_squared_distance():
+    """Against a brute-force search over every assignment of the 7 starts to the 7 places."""
+    from itertools import permutations
+
+    from tmem.world.formation import generate
+    from tmem.world.initial import build
+
+    scenario = tmem.loads(SCATTERED)
+    starts = build(scenario).state[:, :, 0]
+    places = generate("hex", 7, 35.0, 2, False).positions + [10.0, -20.0]
+    cost = lambda order: float(((starts[list(order)] - places) ** 2).sum())  # noqa: E731  (agent order[k] at place k)
+    best = min(cost(order) for order in permutations(range(7)))
+    assert cost(range(7)) == pytest.approx(best, rel=1e-12)
+    assert np.ptp(starts, axis=0).max() > 100.0  # scattered: the test could fail
+    gaps = np.linalg.norm(starts[:, None] - starts[None], axis=-1)[np.triu_indices(7, 1)]
+    assert gaps.min() >= 30.0
+
+
+def test_a_scattered_hex_assembles_at_its_centre_without_a_near_miss():
+    scenario = tmem.loads(SCATTERED)
+    trajectory = tmem.simulate(scenario)
+    assert np.abs(trajectory.pair_distance[-1] - 35.0).max() < 0.1
+    assert np.linalg.norm(trajectory.state[-1, :, :, 0].mean(axis=0) - [10.0, -20.0]) < 0.1
+    positions = trajectory.state[:, :, :, 0]  # brute force over every recorded step and pair
+    gaps = np.linalg.norm(positions[:, :, None] - positions[:, None], axis=-1)[:, *np.triu_indices(7, 1)]
+    assert gaps.min() > 3.0

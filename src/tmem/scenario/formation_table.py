@@ -53,7 +53,7 @@ class FormationParams(StrictModel):
         if self.scatter is not None:
             if self.kind == "edges":
                 raise FieldError("scatter", 'is for a generated shape, not kind = "edges"')
-            if self.jitter > 0.0 or self.coupled:
+            if self.jitter > 0.0:
                 raise FieldError("scatter", "scattered agents start uncoupled and unjittered: set coupled = false, jitter = 0")
             if self.min_spacing is None:
                 raise FieldError("min_spacing", "is required with scatter: the least distance between two starts (m)")

@@ -49,6 +49,16 @@ by the clearance), from where the leg before it ends (the group's centre at the 
 reach (W1), and ``s K_V / K_P`` how far ``P*`` (6) leads ``P`` at the speed ``s``: no agent's ``P*``
 comes within an obstacle's reach, so (W1) never pushes and no pair's flag is touched by an obstacle.
 
+**Assembly.**  An ``assemble`` leg flies each agent of a ``[formation]`` on its own straight line from
+where it starts, ``f_i``, to its place ``p_i`` in the shape (assigned by CAPT when the agents are
+scattered, :mod:`tmem.world.initial`), all arriving together at ``T``::
+
+    v_d,i = (p_i - f_i) beta'(t/T) / T + k_p (f_i + beta(t/T) (p_i - f_i) - P_i),  beta = 3 tau^2 - 2 tau^3   (N5)
+
+with (N2) on the agent's own state; ``T`` is the shortest that keeps every agent within the leg's
+speed and ``a_b`` (:func:`tmem.plan.assignment.capt_duration`).  From ``T`` on, the group holds the
+shape's centre by (N1)-(N3) and the pairs, coupled from the start, settle.
+
 Each agent carries its own leg, waypoint and hold point in the record (a checkpoint saves them);
 the centre costs ``O(N)`` per agent, ``O(N^2)`` per step: missions of a few thousand agents at most.
 """
@@ -72,7 +82,7 @@ HERE = np.nan
 
 
 class Navigated(NamedTuple):
-    """The record of (N1)-(N4): the mission as arrays, the loop's numbers, each agent's progress.
+    """The record of (N1)-(N5): the mission as arrays, the loop's numbers, each agent's progress.
 
     ``leg_step``, ``leg_kind``, ``leg_first``, ``leg_stop``, ``leg_velocity``, ``leg_span`` (legs; the
     span is an ``assemble`` leg's ``T`` (s)); ``place`` (each agent's place in the shape, (N5)); ``waypoint``,
@@ -146,9 +156,9 @@ def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: f
     here, legs = start, []
     for k, leg in enumerate(settings.legs):
         points, speeds = [np.asarray(p, dtype=float) for p in leg.points()], leg.speeds()
-        if leg.action == "assemble":
-            legs.append(([], [], here))
+        if leg.action == "assemble":  # then the group holds the shape's centre (N5)
             here = shape_centre(scenario, leg)
+            legs.append(([here], [float(leg.speed)], None))
             continue
         if leg.avoid:
             if here is None:
@@ -210,7 +220,7 @@ def _turns(points: list[np.ndarray], speeds: list[float], start: np.ndarray | No
 
 
 def navigation_record(settings: NavigationParams, scenario, gains) -> Navigated:
-    """The record of (N1)-(N4) for a run of ``scenario`` (see :class:`Navigated`)."""
+    """The record of (N1)-(N5) for a run of ``scenario`` (see :class:`Navigated`)."""
     from tmem.vehicles import vehicle_class
     from tmem.world.initial import build
 
@@ -336,6 +346,8 @@ def _push(i, k, known, agents, box, nav):
         return
     n_axes = len(box)
     kind = nav.leg_kind[leg]
+    if kind == ASSEMBLE and (k - nav.leg_step[leg]) * nav.dt >= nav.leg_span[leg]:
+        kind = POINTS  # placed: the group holds the shape's centre
     if kind == ASSEMBLE:  # its own state, towards its own place
         for a in range(n_axes):
             for s in range(nav.centre.shape[2]):
@@ -367,7 +379,7 @@ def _push(i, k, known, agents, box, nav):
 
 
 class Navigation(AgentTerm):
-    """(N1)-(N4): a group flying a mission (module text)."""
+    """(N1)-(N5): a group flying a mission (module text)."""
 
     name = "navigation"
     table = NavigationParams
@@ -380,7 +392,7 @@ class Navigation(AgentTerm):
 
     @classmethod
     def record(cls, settings: NavigationParams, scenario, gains) -> Navigated:
-        """The record of (N1)-(N4) for a run of ``scenario`` (:func:`navigation_record`)."""
+        """The record of (N1)-(N5) for a run of ``scenario`` (:func:`navigation_record`)."""
         return navigation_record(settings, scenario, gains)
 
     @classmethod

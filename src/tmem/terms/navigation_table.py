@@ -126,6 +126,10 @@ class NavigationParams(StrictModel):
             if leg.action == "assemble" and (scenario.formation is None or scenario.formation.kind == "edges"):
                 raise FieldError(f"navigation.legs[{k}].action", "'assemble' needs a [formation] of a generated kind "
                                  "(chain, ring, triangle, hex): the shape its agents take")  # fmt: skip
+            if leg.action == "assemble" and not scenario.formation.coupled:
+                raise FieldError(f"navigation.legs[{k}].action", "'assemble' needs the pairs coupled from the start "
+                                 "(formation.coupled = true): uncoupled, the push f1 between d_t and R + R_j stops agents "
+                                 "that arrive at rest, short of the coupling window (docs/missions.md)")  # fmt: skip
             if leg.action == "assemble" and isinstance(leg.speed, list):
                 raise FieldError(f"navigation.legs[{k}].speed", "is one speed for assemble: every agent's top speed (m/s)")
             if leg.action == "assemble" and [other.action for other in self.legs[:k]].count("assemble"):
