@@ -5,6 +5,7 @@ complete graphs, rotated copies of a shape."""
 from __future__ import annotations
 
 import itertools
+import json
 import math
 
 import numpy as np
@@ -314,3 +315,51 @@ def test_time_to_goal_against_a_loop():
     assert fm.time_to_goal(positions, times, goal, 0.3, active) == pytest.approx(times[last_away + 1])
     assert fm.time_to_goal(positions[:32], times[:32], goal, 0.3, active[:32]) is None
     assert fm.time_to_goal(positions[26:31], times[26:31], goal, 0.3) == pytest.approx(times[26])
+
+
+# --- the summary ---------------------------------------------------------------------------------
+
+
+#: Every key of the summary.
+KEYS = {
+    "order_mean", "order_min", "min_separation", "near_misses", "safety_share_max", "safety_share_mean", "closest_pass",
+    "collisions", "union_max", "algebraic_connectivity_min", "min_obstacle_clearance", "min_wall_clearance", "edge_error_max",
+    "edge_error_rms", "edge_error_max_final", "edge_error_rms_final", "shape_distance_final", "time_to_goal",
+}  # fmt: skip
+
+
+def test_every_key_of_the_summary_is_documented_in_the_module():
+    assert all(f"``{key}``" in fm.__doc__ for key in KEYS)
+
+
+def test_the_summary_of_a_triangle_flying_to_a_goal_in_closed_form():
+    side, speed = 2.0, 0.5  # flies along x to (4, 0), there at t = 8 s and stays: within 0.52 m from t = 6.96 s
+    triangle = polygon(3, side / np.sqrt(3))
+    top = triangle[np.argmax(triangle[:, 1])]
+    times = np.linspace(0, 10, 101)
+    positions = triangle[None] + speed * np.minimum(times, 8.0)[:, None, None] * np.array([1.0, 0.0])
+    velocities = np.where((times < 8.0)[:, None, None], np.broadcast_to([speed, 0.0], positions.shape), 0.0)
+    summary = fm.field_summary(
+        positions, velocities, times, edges=[[0, 1], [1, 2]], d_t=1.5, target=triangle @ rotation_2d(1.0).T + 4,
+        obstacles=([[top[0], 10.0]], [2.0]), box=[20.0, 0.0], safety_radius=2.5, collision_radius=1.0,
+        communication_range=2.5, goal=[4.0, 0.0], goal_tolerance=0.52,
+    )  # fmt: skip
+    assert json.loads(json.dumps(summary, allow_nan=False)) == summary
+    expected = {
+        "order_mean": 1.0, "order_min": 1.0, "min_separation": side, "near_misses": 3, "safety_share_max": 1.0,
+        "safety_share_mean": 1.0, "closest_pass": side, "collisions": 0, "union_max": 1, "algebraic_connectivity_min": 3.0,
+        "edge_error_max": 0.5, "edge_error_rms": 0.5, "edge_error_max_final": 0.5, "edge_error_rms_final": 0.5,
+        "shape_distance_final": 0.0, "time_to_goal": 7.0, "min_wall_clearance": triangle[:, 0].min(),
+        "min_obstacle_clearance": 10.0 - top[1] - 2.0,
+    }  # fmt: skip
+    assert set(summary) == KEYS
+    assert summary == pytest.approx(expected, abs=1e-9)
+
+
+def test_the_summary_leaves_out_what_was_not_given():
+    positions, velocities, _ = random_case(1)
+    summary = fm.field_summary(positions, velocities, np.arange(len(positions)))
+    assert set(summary) == KEYS
+    assert {key for key, value in summary.items() if value is not None} == {"order_mean", "order_min", "min_separation"}
+    with pytest.raises(ValueError, match="goal_tolerance"):
+        fm.field_summary(positions, velocities, np.arange(len(positions)), goal=[0.0, 0.0, 0.0])

@@ -8,6 +8,23 @@ velocity is :func:`tmem.analysis.rms.rms_velocity`.  Sources, each function sayi
 SwarmLab (Soria et al., arXiv:2005.02769; ``compute_swarm_performance.m`` of github.com/lis-epfl/swarmlab at
 3574ded) and Vásárhelyi et al., Sci. Robot. 3, eaat3536 (2018), "Order parameters" (its simulator's
 statistics: ``src/algo_spp_evol_stat.c`` of github.com/csviragh/robotsim).
+
+:func:`field_summary` returns a flat dict of JSON-ready values, ``None`` where the input is not given or the
+value undefined:
+
+* ``order_mean`` (1): :func:`order`'s mean over the records of the run's second half (by ``times``);
+  ``order_min`` (1): its least.  ``min_separation`` (m): :func:`min_separation`.
+* ``near_misses`` (count), ``safety_share_max`` and ``safety_share_mean`` (1), ``closest_pass`` (m):
+  :func:`near_misses` at ``safety_radius``: its ``count``, the largest and the mean of its
+  ``pairs_within_share``, its ``closest_pass``.  ``collisions`` (count): :func:`collisions`.
+* ``union_max`` (count): the most groups at once (:func:`union`); ``algebraic_connectivity_min`` (1):
+  the least :func:`algebraic_connectivity` over the records it evaluates (every ``connectivity_every``-th),
+  ``None`` with over :data:`MAX_CONNECTIVITY_AGENTS` agents.
+* ``min_obstacle_clearance`` and ``min_wall_clearance`` (m): the least :func:`obstacle_clearance` and
+  :func:`wall_clearance`.  ``shape_distance_final`` (m): :func:`shape_distance` at the last record.
+* ``edge_error_max`` and ``edge_error_rms`` (m): the largest ``|e|`` and the RMS of :func:`edge_errors`
+  over every record and edge; ``edge_error_max_final`` and ``edge_error_rms_final`` (m): at the last.
+* ``time_to_goal`` (s): :func:`time_to_goal`.
 """
 
 from __future__ import annotations
@@ -20,7 +37,7 @@ from scipy.spatial import cKDTree
 
 __all__ = [
     "order", "separations", "min_separation", "near_misses", "collisions", "union", "algebraic_connectivity",
-    "obstacle_clearance", "wall_clearance", "edge_errors", "shape_distance", "time_to_goal",
+    "obstacle_clearance", "wall_clearance", "edge_errors", "shape_distance", "time_to_goal", "field_summary",
 ]  # fmt: skip
 
 #: The most active agents :func:`algebraic_connectivity` takes (a dense eigenvalue problem a record).
@@ -37,6 +54,10 @@ def _reduce(values, how=np.min) -> float | None:
     values = np.asarray(values, float)
     values = values[np.isfinite(values)]
     return float(how(values)) if values.size else None
+
+
+def _rms(values: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(values**2)))
 
 
 def order(velocities: np.ndarray, active: np.ndarray | None = None) -> np.ndarray:
@@ -328,3 +349,49 @@ def time_to_goal(positions: np.ndarray, times: np.ndarray, goal: np.ndarray, tol
         return None
     away = np.flatnonzero(~near)
     return float(np.asarray(times, float)[away[-1] + 1 if away.size else 0])
+
+
+def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarray, active: np.ndarray | None = None, *,
+                  edges: np.ndarray | None = None, d_t: float | np.ndarray | None = None, target: np.ndarray | None = None,
+                  obstacles: tuple[np.ndarray, np.ndarray] | None = None, box: np.ndarray | None = None,
+                  safety_radius: float | None = None, collision_radius: float | None = None,
+                  communication_range: float | None = None, connectivity_every: int = 1,
+                  goal: np.ndarray | None = None, goal_tolerance: float | None = None) -> dict:  # fmt: skip
+    """The run's metrics as a flat dict of JSON-ready values: the keys and units of the module's docstring.
+
+    Parameters
+    ----------
+    positions, velocities, times, active : the recorded arrays (module docstring); edges and shape take every agent
+    edges, d_t : :func:`edge_errors`'s, optional
+    target : :func:`shape_distance`'s, optional
+    obstacles : (centers, radii), :func:`obstacle_clearance`'s, optional
+    box : :func:`wall_clearance`'s, optional
+    safety_radius, collision_radius : float, :func:`near_misses`'s and :func:`collisions`'s (m), optional
+    communication_range, connectivity_every : :func:`algebraic_connectivity`'s range (m; :func:`union`'s too) and ``every``
+    goal, goal_tolerance : :func:`time_to_goal`'s ``goal`` and ``tolerance``, optional
+    """
+    p, times = np.asarray(positions, float), np.asarray(times, float)
+    flying = _flying(active, p.shape[:2])
+    if goal is not None and goal_tolerance is None:
+        raise ValueError("field_summary needs goal_tolerance with a goal")
+    phi = order(velocities, flying)
+    found = {} if safety_radius is None else near_misses(p, times, safety_radius, flying)
+    share = found.get("pairs_within_share", ())
+    wide = communication_range is None or flying.sum(axis=1).max() > MAX_CONNECTIVITY_AGENTS
+    errors = np.abs(edge_errors(p, edges, d_t)) if edges is not None else np.zeros((1, 0))
+    return {
+        "order_mean": _reduce(phi[times >= (times[0] + times[-1]) / 2], np.mean), "order_min": _reduce(phi),
+        "min_separation": min_separation(p, flying), "near_misses": found.get("count"),
+        "safety_share_max": _reduce(share, np.max), "safety_share_mean": _reduce(share, np.mean),
+        "closest_pass": found.get("closest_pass"),
+        "collisions": None if collision_radius is None else collisions(p, times, collision_radius, flying),
+        "union_max": None if communication_range is None else int(union(p, communication_range, flying).max()),
+        "algebraic_connectivity_min": None if wide else _reduce(
+            algebraic_connectivity(p, communication_range, flying, connectivity_every)),
+        "min_obstacle_clearance": None if obstacles is None else _reduce(obstacle_clearance(p, *obstacles, flying)),
+        "min_wall_clearance": None if box is None else _reduce(wall_clearance(p, box, flying)),
+        "edge_error_max": _reduce(errors, np.max), "edge_error_rms": _reduce(errors, _rms),
+        "edge_error_max_final": _reduce(errors[-1], np.max), "edge_error_rms_final": _reduce(errors[-1], _rms),
+        "shape_distance_final": None if target is None else _reduce(shape_distance(p[-1:], target)),
+        "time_to_goal": None if goal is None else time_to_goal(p, times, goal, goal_tolerance, flying),
+    }  # fmt: skip
