@@ -339,6 +339,7 @@ def test_the_summary_of_a_triangle_flying_to_a_goal_in_closed_form():
     times = np.linspace(0, 10, 101)
     positions = triangle[None] + speed * np.minimum(times, 8.0)[:, None, None] * np.array([1.0, 0.0])
     velocities = np.where((times < 8.0)[:, None, None], np.broadcast_to([speed, 0.0], positions.shape), 0.0)
+    velocities[times < 5.0] = polygon(3)  # a regular fan for the first half: order -1/2, then 1 (none once at rest)
     summary = fm.field_summary(
         positions, velocities, times, edges=[[0, 1], [1, 2]], d_t=1.5, target=triangle @ rotation_2d(1.0).T + 4,
         obstacles=([[top[0], 10.0]], [2.0]), box=[20.0, 0.0], safety_radius=2.5, collision_radius=1.0,
@@ -346,7 +347,7 @@ def test_the_summary_of_a_triangle_flying_to_a_goal_in_closed_form():
     )  # fmt: skip
     assert json.loads(json.dumps(summary, allow_nan=False)) == summary
     expected = {
-        "order_mean": 1.0, "order_min": 1.0, "min_separation": side, "near_misses": 3, "safety_share_max": 1.0,
+        "order_mean": 1.0, "order_min": -0.5, "min_separation": side, "near_misses": 3, "safety_share_max": 1.0,
         "safety_share_mean": 1.0, "closest_pass": side, "collisions": 0, "union_max": 1, "algebraic_connectivity_min": 3.0,
         "edge_error_max": 0.5, "edge_error_rms": 0.5, "edge_error_max_final": 0.5, "edge_error_rms_final": 0.5,
         "shape_distance_final": 0.0, "time_to_goal": 7.0, "min_wall_clearance": triangle[:, 0].min(),
@@ -354,6 +355,20 @@ def test_the_summary_of_a_triangle_flying_to_a_goal_in_closed_form():
     }  # fmt: skip
     assert set(summary) == KEYS
     assert summary == pytest.approx(expected, abs=1e-9)
+
+
+def test_the_summary_over_the_run_and_at_its_end_of_two_agents_apart_1_2_and_1_5_m():
+    positions = np.zeros((3, 2, 2))
+    positions[:, 1, 0] = [1.0, 2.0, 1.5]  # edge errors against d_t 1 and 1.5: (0, -0.5), (1, 0.5), (0.5, 0)
+    summary = fm.field_summary(
+        positions, np.ones_like(positions), np.arange(3.0), edges=[[0, 1], [1, 0]], d_t=[1.0, 1.5], safety_radius=1.6,
+    )  # fmt: skip
+    expected = {
+        "edge_error_max": 1.0, "edge_error_rms": np.sqrt(1.75 / 6),
+        "edge_error_max_final": 0.5, "edge_error_rms_final": np.sqrt(0.125),
+        "near_misses": 2, "safety_share_max": 1.0, "safety_share_mean": 2 / 3, "closest_pass": 1.0, "min_separation": 1.0,
+    }  # fmt: skip
+    assert {key: summary[key] for key in expected} == pytest.approx(expected, rel=1e-12)
 
 
 def test_the_summary_leaves_out_what_was_not_given():
