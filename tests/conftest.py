@@ -25,7 +25,8 @@ KINDS = ("unit", "physics", "pins", "interface")
 #: Each test module's kind, by the name of its module (shell patterns allowed), for the tests that
 #: are not marked with a kind of their own.
 MODULE_KINDS = {
-    "unit": ["test_kernels", "test_interaction", "test_coupling", "test_metrics", "test_coverage", "test_plan"],
+    "unit": ["test_kernels", "test_interaction", "test_coupling", "test_metrics", "test_coverage", "test_plan",
+             "test_field_metrics"],
     "physics": [
         "test_model", "test_control", "test_reference", "test_settling", "test_paper_results", "test_engine",
         "test_terms", "test_swarm", "test_gas", "test_sensing", "test_sensing_runs", "test_batch",
