@@ -1,0 +1,116 @@
+"""The mission as the navigation flies it: each leg's points and speeds, routes planned around obstacles (N4),
+an assembly's places and span (N5), the turns along a route (N3).
+
+Planning runs once, when a run's record is built (:func:`tmem.terms.navigation.navigation_record`);
+:func:`planned_points` gives the same legs to figures and the viewer.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tmem.scenario.tables import FieldError
+
+#: The waypoint rows of a ``hold`` without a target: where the group is when the leg starts.
+HERE = np.nan
+
+
+def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: float, lead: float):
+    """Each leg's points, speeds and planned start (None where the group's place is not known then: after
+    a velocity leg), the avoiding legs' routes planned around the obstacles (N4)."""
+    obstacles = np.array([o.center for o in scenario.obstacles], dtype=float).reshape(-1, scenario.space.axes)
+    radii = np.array([o.radius for o in scenario.obstacles], dtype=float)
+    here, legs = start, []
+    for k, leg in enumerate(settings.legs):
+        points, speeds = [np.asarray(p, dtype=float) for p in leg.points()], leg.speeds()
+        if leg.action == "assemble":  # then the group holds the shape's centre (N5)
+            here = shape_centre(scenario, leg)
+            legs.append(([here], [float(leg.speed)], None))
+            continue
+        if leg.avoid:
+            if here is None:
+                raise FieldError(f"navigation.legs[{k}].avoid", "follows a velocity leg: there is no point to plan from")
+            from tmem.plan.route import plan_route
+
+            clearance = r_group + scenario.wall_reach + lead * max(speeds)
+            routed, routed_speeds, origin = [], [], here
+            for point, speed in zip(points, speeds):
+                try:
+                    path = plan_route(origin, point, obstacles, radii, clearance)
+                except ValueError as error:
+                    raise FieldError(f"navigation.legs[{k}].avoid", f"{error} (clearance {clearance:.4g} m, (N4))") from None
+                routed += list(path[1:])
+                routed_speeds += [speed] * (len(path) - 1)
+                origin = point
+            points, speeds = routed, routed_speeds
+        if leg.action == "hold" and not points:
+            points, speeds = [np.full(scenario.space.axes, HERE)], [np.inf]
+        legs.append((points, speeds, here))
+        here = None if leg.action == "velocity" or np.isnan(points[-1][0]) else points[-1]
+    return legs
+
+
+def shape_centre(scenario, leg) -> np.ndarray:
+    """Where an ``assemble`` leg puts the centre of the formation's shape: its ``target``, or ``[formation] center``."""
+    f = scenario.formation
+    return np.asarray(leg.target if leg.target is not None else (f.center or [0.0] * scenario.space.axes), dtype=float)
+
+
+def places(scenario, leg, starts: np.ndarray, a_b: float) -> tuple[np.ndarray, float]:
+    """(N5): each agent's place in the formation's shape and the leg's span ``T`` (s), the shortest over which
+    the cubic time scaling keeps every agent within the leg's speed and the braking acceleration."""
+    from tmem.plan.assignment import capt_duration
+    from tmem.world.formation import generate
+
+    f = scenario.formation
+    d_t = scenario.interaction.d_t if f.d_t is None else f.d_t
+    places = generate(f.kind, len(starts), d_t, scenario.space.axes, f.bearing).positions + shape_centre(scenario, leg)
+    span = capt_duration(starts, places, np.arange(len(starts)), float(leg.speed), a_b)
+    return places, max(span, scenario.simulation.dt)
+
+
+def turns(points: list[np.ndarray], speeds: list[float], start: np.ndarray | None, a_b: float) -> list[float]:
+    """Distance before each point where the group turns to the next segment (module text); 0 at the last."""
+    turns = []
+    for w, point in enumerate(points[:-1]):
+        before = points[w - 1] if w else start
+        if before is None:
+            turns.append(0.0)
+            continue
+        inward, outward = point - before, points[w + 1] - point
+        lengths = np.linalg.norm(inward), np.linalg.norm(outward)
+        cosine = float(inward @ outward / (lengths[0] * lengths[1])) if min(lengths) > 0 else 1.0
+        theta = np.arccos(np.clip(cosine, -1.0, 1.0))
+        radius = max(speeds[w], speeds[w + 1]) ** 2 / a_b
+        turns.append(float(min(radius * np.tan(min(theta, 0.99 * np.pi) / 2), 0.5 * min(lengths))))
+    return turns + [0.0] if points else []
+
+
+def flown(scenario, gains):
+    """The run's initial arrays, and each leg's points, speeds and planned start (:func:`_planned`)."""
+    from tmem.world.initial import build
+
+    initial = build(scenario)
+    positions = initial.state[initial.active, :, 0]
+    start = positions.mean(axis=0)
+    r_group = float(np.max(np.linalg.norm(positions - start, axis=1))) if len(positions) else 0.0
+    return initial, _planned(scenario.navigation, scenario, start, r_group, float(gains[1] / gains[0]))
+
+
+def planned_points(scenario) -> list[tuple[float, str, np.ndarray]]:
+    """The mission as flown: each leg's start time (s), action and points (m, shape (W, axes); the
+    routes of ``avoid`` legs as planned (N4), an ``assemble`` leg's shape centre; none for ``velocity``
+    and for a ``hold`` where the group is), for figures and the viewer.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario with a ``[navigation]`` table.
+    """
+    from tmem.vehicles import vehicle_class
+
+    c = scenario.controller
+    _, legs = flown(scenario, vehicle_class(scenario.model.kind)(scenario.model).gains(c.r_l, c.im_l, c.im_r))
+    axes = scenario.space.axes
+    return [(leg.time, leg.action, np.array([q for q in points if not np.isnan(q[0])], dtype=float).reshape(-1, axes))
+            for leg, (points, _, _) in zip(scenario.navigation.legs, legs)]  # fmt: skip
