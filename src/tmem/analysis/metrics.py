@@ -13,6 +13,7 @@ import numpy as np
 from tmem.engine import Event, Trajectory
 from tmem.analysis.coverage import coverage_summary
 from tmem.analysis.observables import gas_summary
+from tmem.analysis.safety import safety_summary
 from tmem.analysis.rms import rms_summary, rms_velocity  # noqa: F401  (rms_velocity: read from here too)
 
 
@@ -315,7 +316,8 @@ def summarize(trajectory: Trajectory) -> dict:
     :func:`tmem.analysis.rms.rms_summary`; coupling:
     :func:`coupling_summary`; the gas's observables (when observed):
     :func:`tmem.analysis.observables.gas_summary`; the coverage of a walled box:
-    :func:`~tmem.analysis.coverage.runs.coverage_summary`.  ``min_distance`` is the smallest distance two
+    :func:`~tmem.analysis.coverage.runs.coverage_summary`; safety and the field's figures (with a
+    ``[safety]`` table): :func:`tmem.analysis.safety.safety_summary`.  ``min_distance`` is the smallest distance two
     agents reached at any step (formation pairs always; other pairs once within
     ``R + R_j``); ``final_distance`` the smallest distance between two flying
     agents at the end.  Every number is finite: ``None`` (JSON ``null``) stands
@@ -349,5 +351,6 @@ def summarize(trajectory: Trajectory) -> dict:
         "formation": formation_summary(trajectory),
         "gas": gas_summary(trajectory),
         "coverage": coverage_summary(trajectory),
+        "safety": safety_summary(trajectory),
         "pairs": [pair_summary(trajectory, p) for p in range(len(trajectory.pairs))],
     }

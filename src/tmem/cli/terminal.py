@@ -63,6 +63,8 @@ def _number(value: float | None, form: str) -> str:
 SWINGS = f"* {swinging_note}"
 #: The table's columns, after the run's name.
 HEADERS = ("function", "coupled", "couple (s)", "uncouple (s)", "ΔRMS (%)", "largest ΔRMS (%)", "min dist (m)")
+#: The columns added where a run has a ``[safety]`` table.
+SAFETY_HEADERS = ("near misses", "clearance (m)")
 
 
 def _coupled_cell(s: dict) -> str:
@@ -72,28 +74,44 @@ def _coupled_cell(s: dict) -> str:
     return f"yes, {s['pairs_coupled_at_end']}/{len(s['pairs'])} at end"
 
 
-def _cells(s: dict) -> list[str]:
-    """The figures of one run, in the order of :data:`HEADERS`."""
+def _safety_cells(s: dict) -> list[str]:
+    """A run's near misses at its safety radius and its least clearance to obstacles and walls (:data:`SAFETY_HEADERS`)."""
+    safety = s.get("safety")
+    if not safety:
+        return ["—", "—"]
+    clear = [c for c in (safety["min_obstacle_clearance"], safety["min_wall_clearance"]) if c is not None]
+    return [f"{safety['near_misses']} within {safety['radius']:g} m", _number(min(clear) if clear else None, "{:.2f}")]
+
+
+def _headers(rows: dict[str, dict]) -> tuple[str, ...]:
+    """The columns of these runs: :data:`HEADERS`, and :data:`SAFETY_HEADERS` where one has a ``[safety]`` table."""
+    return HEADERS + (SAFETY_HEADERS if any(s.get("safety") for s in rows.values()) else ())
+
+
+def _cells(s: dict, headers: tuple[str, ...] = HEADERS) -> list[str]:
+    """The figures of one run, in the order of ``headers``."""
     peak, at = s.get("rms_change_peak_percent"), s.get("rms_change_peak_time")
-    return [
+    cells = [
         s["function"], _coupled_cell(s), _number(s["couple_time"], "{:.2f}"), _number(s["uncouple_time"], "{:.2f}"),
         _number(s["rms_change_percent"], "{:+.3f}") + (" *" if swings(s) else ""),
         "—" if peak is None else f"{peak:+.3f} at {at:.2f} s", _number(s["min_distance"], "{:.2f}"),
     ]  # fmt: skip
+    return cells + (_safety_cells(s) if len(headers) > len(HEADERS) else [])
 
 
 def _wide(rows: dict[str, dict]) -> Table:
     """One row per run."""
-    table = Table(*(Column(h, no_wrap=True) for h in ("run", *HEADERS)), box=box.SIMPLE_HEAD, pad_edge=False)
+    headers = _headers(rows)
+    table = Table(*(Column(h, no_wrap=True) for h in ("run", *headers)), box=box.SIMPLE_HEAD, pad_edge=False)
     for name, s in rows.items():
-        table.add_row(Text(name), *_cells(s))
+        table.add_row(Text(name), *_cells(s, headers))
     return table
 
 
-def _block(s: dict) -> Table:
+def _block(s: dict, headers: tuple[str, ...]) -> Table:
     """One run's figures, one row each: (figure, value)."""
     table = Table(Column(no_wrap=True), Column(no_wrap=True), box=None, pad_edge=False, show_header=False)
-    for header, cell in zip(HEADERS, _cells(s)):
+    for header, cell in zip(headers, _cells(s, headers)):
         table.add_row(header, cell)
     return table
 
@@ -128,7 +146,7 @@ class RunsTable:
         else:
             for name, s in self.rows.items():
                 yield Text(name, style="bold")
-                yield Padding(_block(s), (0, 0, 1, 2))
+                yield Padding(_block(s, _headers(self.rows)), (0, 0, 1, 2))
         if any(swings(s) for s in self.rows.values()):
             yield Text(SWINGS)
 

@@ -31,6 +31,7 @@ from tmem.scenario.budget import check_memory, check_record_size, memory_limit
 from tmem.scenario.commands_table import Command, check_commands
 from tmem.scenario.formation_table import FormationParams, check_formation
 from tmem.scenario.motion_bounds import check_motion
+from tmem.scenario.safety_table import SafetyParams, check_safety
 from tmem.scenario.sensing_table import SensingParams, check_sensing
 from tmem.scenario.space_table import CoverageParams, Obstacle, SpaceParams, ThermostatParams
 from tmem.scenario.tables import (
@@ -87,6 +88,7 @@ class _Scenario(StrictModel):
     coverage: CoverageParams | None = None
     sensing: SensingParams | None = None
     wind: WindParams | None = None
+    safety: SafetyParams | None = None
     obstacles: list[Obstacle] = []
     agents: list[Agent] = []
     commands: list[Command] = []
@@ -228,6 +230,7 @@ class _Scenario(StrictModel):
         check_record_size(self, n, len(pairs))
         self._check_formation_room(axes, n)
         doubts = check_vehicle(self) + check_motion(self)  # the physical bounds (docs/parameters.md, "Bounds")
+        doubts += check_safety(self) if self.safety else []
         warn(doubts)  # only once every check has passed: a refused scenario warns of nothing
         return self
 

@@ -94,10 +94,17 @@ _GAS_KEYS = (
     "|pressure_ideal|encounter_rate|mean_free_path|breaches"
 )
 _COVERAGE_KEYS = "share_final|time_to_50|time_to_90"
+_SAFETY_KEYS = (
+    "radius|closing_speed_limit|order_mean|order_min|min_separation|near_misses|safety_share_max|safety_share_mean"
+    "|closest_pass|collisions|union_max|algebraic_connectivity_min|min_obstacle_clearance|min_wall_clearance"
+    "|edge_error_max|edge_error_rms|edge_error_max_final|edge_error_rms_final|shape_distance_final|time_to_goal"
+)
 #: Nested figures of ``summary.json`` by dotted path: per formation, per pair (by its index), of the
-#: gas (:func:`tmem.analysis.observables.gas_summary`) and of the coverage (:func:`~tmem.analysis.coverage.runs.coverage_summary`).
+#: gas (:func:`tmem.analysis.observables.gas_summary`), of the coverage (:func:`~tmem.analysis.coverage.runs.coverage_summary`)
+#: and of safety and the field's figures (:func:`tmem.analysis.safety.safety_summary`).
 NESTED_METRIC = re.compile(
     rf"formation\.({_FORMATION_KEYS})|pairs\.\d+\.({_PAIR_KEYS})|gas\.({_GAS_KEYS})|coverage\.({_COVERAGE_KEYS})"
+    rf"|safety\.({_SAFETY_KEYS})"
 )
 #: Most cases one sweep may have.
 MAX_CASES = 1_000_000
@@ -213,7 +220,8 @@ class SweepFile(StrictModel):
             raise FieldError("cases", "counts random draws, but there is no [random] table")
         for m in self.metrics:
             if m not in SCALAR_METRICS and not NESTED_METRIC.fullmatch(m):
-                raise FieldError("metrics", f"unknown metric {m!r}; choose from {', '.join(SCALAR_METRICS)}, formation.*, pairs.N.*, gas.*, coverage.*")
+                raise FieldError("metrics", f"unknown metric {m!r}; choose from {', '.join(SCALAR_METRICS)}, "
+                                 "formation.*, pairs.N.*, gas.*, coverage.*, safety.*")  # fmt: skip
         if len(set(self.metrics)) != len(self.metrics):
             raise FieldError("metrics", "lists a metric twice")
         where: dict[str, str] = {}  # path -> the table that gives it; explicit cases may share paths

@@ -7,9 +7,14 @@ Planning runs once, when a run's record is built (:func:`tmem.terms.navigation.n
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from tmem.scenario.tables import FieldError
+
+if TYPE_CHECKING:
+    from tmem.terms.navigation_table import NavigationParams
 
 #: The waypoint rows of a ``hold`` without a target: where the group is when the leg starts.
 HERE = np.nan
@@ -64,9 +69,9 @@ def places(scenario, leg, starts: np.ndarray, a_b: float) -> tuple[np.ndarray, f
 
     f = scenario.formation
     d_t = scenario.interaction.d_t if f.d_t is None else f.d_t
-    places = generate(f.kind, len(starts), d_t, scenario.space.axes, f.bearing).positions + shape_centre(scenario, leg)
-    span = capt_duration(starts, places, np.arange(len(starts)), float(leg.speed), a_b)
-    return places, max(span, scenario.simulation.dt)
+    slots = generate(f.kind, len(starts), d_t, scenario.space.axes, f.bearing).positions + shape_centre(scenario, leg)
+    span = capt_duration(starts, slots, np.arange(len(starts)), float(leg.speed), a_b)
+    return slots, max(span, scenario.simulation.dt)
 
 
 def turns(points: list[np.ndarray], speeds: list[float], start: np.ndarray | None, a_b: float) -> list[float]:
