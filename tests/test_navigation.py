@@ -195,3 +195,54 @@ def test_a_scattered_hex_assembles_at_its_centre_without_a_near_miss():
     positions = trajectory.state[:, :, :, 0]  # brute force over every recorded step and pair
     gaps = np.linalg.norm(positions[:, :, None] - positions[:, None], axis=-1)[:, *np.triu_indices(7, 1)]
     assert gaps.min() > 3.0
+
+
+AROUND = """
+name = "hex7-around"
+[space]
+axes = 2
+[interaction]
+function = "improved"
+synchronise = true
+d_t = 35.0
+[formation]
+kind = "hex"
+n = 7
+velocity = [0.0, 0.0]
+[navigation]
+[[navigation.legs]]
+time = 0.0
+action = "goto"
+target = [600.0, 0.0]
+speed = 5.0
+avoid = true
+[[obstacles]]
+center = [300.0, 10.0]
+radius = 50.0
+[safety]
+radius = 3.0
+[simulation]
+dt = 0.001
+duration = 200.0
+record_every = 500
+"""
+
+
+def test_a_group_sent_round_an_obstacle_keeps_every_agent_out_of_its_reach():
+    """(N4): the obstacle on the straight line never pushes; brute force over the recorded positions."""
+    from tmem.terms.navigation_plan import planned_points
+
+    scenario = tmem.loads(AROUND)
+    route = planned_points(scenario)[0][2]
+    assert len(route) > 1  # it turned: the straight line would cross the obstacle
+    trajectory = tmem.simulate(scenario)
+    gaps = np.linalg.norm(trajectory.state[:, :, :, 0] - [300.0, 10.0], axis=-1) - 50.0
+    assert gaps.min() >= scenario.wall_reach
+    assert np.abs(trajectory.pair_distance - 35.0).max() < 1e-8
+    assert np.linalg.norm(trajectory.state[-1, :, :, 0].mean(axis=0) - [600.0, 0.0]) < 0.5
+
+
+def test_a_goal_inside_an_obstacles_clearance_is_refused_in_one_line():
+    with pytest.raises(ScenarioError, match=r"navigation\.legs\[0\]\.avoid: .*goal.* \(clearance 75\.8\d* m, \(N4\)\)"):
+        with_changes(tmem.loads(AROUND), {"navigation.legs": [
+            {"time": 0.0, "action": "goto", "target": [300.0, 80.0], "speed": 5.0, "avoid": True}]})

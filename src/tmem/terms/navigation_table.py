@@ -137,3 +137,7 @@ class NavigationParams(StrictModel):
             if leg.avoid and not scenario.obstacles:
                 raise FieldError(f"navigation.legs[{k}].avoid", "has no [[obstacles]] to plan around")
         loop_gains(scenario, self.bandwidth)  # refuses a bandwidth the tilt loop cannot follow
+        if any(leg.avoid for leg in self.legs):
+            from tmem.terms.navigation_plan import planned_points
+
+            planned_points(scenario)  # refuses a route that cannot clear the obstacles (N4)
