@@ -1,5 +1,5 @@
 """A run's safety figures in ``summary.json``: against brute force over the recorded steps, and the
-closing-speed limit (SF1) against the pair's own stopping distance."""
+closing-speed limit (M1) against the pair's own stopping distance."""
 
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ def _closest(trajectory) -> float:
 
 @pytest.mark.parametrize("speed", [4.0, 9.0])
 def test_a_pair_slower_than_the_limit_keeps_outside_the_radius_and_a_faster_one_does_not(speed):
-    """(SF1): at c_max = 0.02 rad the limit is sqrt(4 g c_max (40 - 3)) = 5.39 m/s of closing speed."""
+    """(M1): at c_max = 0.02 rad the limit is sqrt(4 g c_max (40 - 3)) = 5.39 m/s of closing speed."""
     scenario = tmem.loads(HEAD_ON.format(c_max=0.02, speed=speed / 2))
     summary = summarize(tmem.simulate(scenario))["safety"]
     assert summary["closing_speed_limit"] == pytest.approx(math.sqrt(4 * 9.8 * 0.02 * 37.0))

@@ -6,7 +6,7 @@ the safety radius (counted once per encounter, passes between two records includ
 the smallest separation, the clearance to obstacles and walls, order, groups and algebraic
 connectivity at the communication range, the formation's edge errors and its distance to the
 target shape (translation and rotation aside), and the time the group's centre takes to reach a
-mission's goal; beside them the safety radius and the closing-speed limit (SF1).
+mission's goal; beside them the safety radius and the closing-speed limit (M1).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def _target(trajectory: Trajectory) -> np.ndarray | None:
 
 
 def safety_summary(trajectory: Trajectory) -> dict | None:
-    """``summary.json``'s ``"safety"``: the radius, the closing-speed limit (SF1) and
+    """``summary.json``'s ``"safety"``: the radius, the closing-speed limit (M1) and
     :func:`~tmem.analysis.field_metrics.field_summary`'s figures; ``None`` without a ``[safety]`` table.
 
     Parameters

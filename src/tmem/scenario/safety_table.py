@@ -11,7 +11,7 @@ Keys (:mod:`tmem.analysis.field_metrics` computes the figures, ``docs/missions.m
 Two agents closing at ``v_c`` come within ``r`` of each other unless the repulsion (8), which starts
 at ``R + R_j`` and at most decelerates their relative motion by ``2 g c_max``, stops them first::
 
-    v_c <= sqrt(4 g c_max (R + R_j - r))                                                  (SF1)
+    v_c <= sqrt(4 g c_max (R + R_j - r))                                                  (M1)
 
 (12 m/s with Table 1, ``c_max = 0.1`` rad and ``r = 3`` m); the summary gives this limit beside the
 near misses, and :func:`check_safety` warns where a scenario's speeds exceed it.
@@ -45,8 +45,14 @@ class SafetyParams(StrictModel):
 
 
 def closing_speed_limit(scenario: Scenario) -> float | None:
-    """(SF1): the fastest two agents may close and still stop outside the safety radius (m/s); ``None``
-    where the radius lies beyond the repulsion's reach, or the model's input is not a tilt."""
+    """(M1): the fastest two agents may close and still stop outside the safety radius (m/s); ``None``
+    where the radius lies beyond the repulsion's reach, or the model's input is not a tilt.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its ``[safety]`` radius, reach, tilt limit and model.
+    """
     model, safety = scenario.model, scenario.safety
     room = scenario.interaction.reach - safety.radius
     g = getattr(model, "g", None)
@@ -57,7 +63,13 @@ def closing_speed_limit(scenario: Scenario) -> float | None:
 
 def check_safety(scenario: Scenario) -> list[tuple[str, str]]:
     """The ``[safety]`` table against the scenario: a radius inside the repulsion's reach (else nothing
-    keeps agents apart at it); the doubts (``field``, ``reason``) where the mission's speed exceeds (SF1)."""
+    keeps agents apart at it); the doubts (``field``, ``reason``) where the mission's speed exceeds (M1).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario with a ``[safety]`` table, its tables valid on their own.
+    """
     safety = scenario.safety
     if safety.radius >= scenario.interaction.reach:
         raise FieldError("safety.radius", f"{safety.radius:g} m is not inside the repulsion's reach R + R_j = "
@@ -67,5 +79,5 @@ def check_safety(scenario: Scenario) -> list[tuple[str, str]]:
     speeds = [s for leg in (nav.legs if nav else []) for s in leg.speeds() if math.isfinite(s)]
     if limit is not None and speeds and 2.0 * max(speeds) > limit:
         return [("safety.radius", f"two agents meeting head-on at the mission's {max(speeds):g} m/s close at "
-             f"{2 * max(speeds):g} m/s, above the {limit:.3g} m/s the tilt limit stops within R + R_j - radius (SF1)")]  # fmt: skip
+             f"{2 * max(speeds):g} m/s, above the {limit:.3g} m/s the tilt limit stops within R + R_j - radius (M1)")]  # fmt: skip
     return []

@@ -148,7 +148,17 @@ def loop_gains(scenario, bandwidth: float) -> np.ndarray:
 
 
 def navigation_record(settings: NavigationParams, scenario, gains) -> Navigated:
-    """The record of (N1)-(N5) for a run of ``scenario`` (see :class:`Navigated`)."""
+    """The record of (N1)-(N5) for a run of ``scenario`` (see :class:`Navigated`).
+
+    Parameters
+    ----------
+    settings : NavigationParams
+        The ``[navigation]`` table.
+    scenario : Scenario
+        The whole scenario.
+    gains : ndarray
+        ``K`` of the law: ``K_V / K_P`` is the lead of ``P*`` (N4).
+    """
     from tmem.vehicles import vehicle_class
 
     axes = scenario.space.axes
@@ -315,7 +325,17 @@ class Navigation(AgentTerm):
 
     @classmethod
     def record(cls, settings: NavigationParams, scenario, gains) -> Navigated:
-        """The record of (N1)-(N5) for a run of ``scenario`` (:func:`navigation_record`)."""
+        """The record of (N1)-(N5) for a run of ``scenario`` (:func:`navigation_record`).
+
+        Parameters
+        ----------
+        settings : NavigationParams
+            The ``[navigation]`` table.
+        scenario : Scenario
+            The whole scenario.
+        gains : ndarray
+            ``K`` of the law.
+        """
         return navigation_record(settings, scenario, gains)
 
     @classmethod

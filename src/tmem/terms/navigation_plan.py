@@ -56,14 +56,34 @@ def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: f
 
 
 def shape_centre(scenario, leg) -> np.ndarray:
-    """Where an ``assemble`` leg puts the centre of the formation's shape: its ``target``, or ``[formation] center``."""
+    """Where an ``assemble`` leg puts the centre of the formation's shape: its ``target``, or ``[formation] center``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its ``[formation]``.
+    leg : Leg
+        The ``assemble`` leg.
+    """
     f = scenario.formation
     return np.asarray(leg.target if leg.target is not None else (f.center or [0.0] * scenario.space.axes), dtype=float)
 
 
 def places(scenario, leg, starts: np.ndarray, a_b: float) -> tuple[np.ndarray, float]:
     """(N5): each agent's place in the formation's shape and the leg's span ``T`` (s), the shortest over which
-    the cubic time scaling keeps every agent within the leg's speed and the braking acceleration."""
+    the cubic time scaling keeps every agent within the leg's speed and the braking acceleration.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its ``[formation]`` and time step.
+    leg : Leg
+        The ``assemble`` leg: its target and speed.
+    starts : ndarray, shape (agents, axes)
+        Where the agents start (m), agent ``k`` flying to place ``k``.
+    a_b : float
+        The acceleration the lines may ask (m/s^2).
+    """
     from tmem.plan.assignment import capt_duration
     from tmem.world.formation import generate
 
@@ -75,7 +95,19 @@ def places(scenario, leg, starts: np.ndarray, a_b: float) -> tuple[np.ndarray, f
 
 
 def turns(points: list[np.ndarray], speeds: list[float], start: np.ndarray | None, a_b: float) -> list[float]:
-    """Distance before each point where the group turns to the next segment (module text); 0 at the last."""
+    """Distance before each point where the group turns to the next segment (module text); 0 at the last.
+
+    Parameters
+    ----------
+    points : list of ndarray
+        A leg's points (m).
+    speeds : list of float
+        The speed towards each (m/s).
+    start : ndarray or None
+        Where the leg starts (m); ``None`` where unknown (no turn before the first point).
+    a_b : float
+        The braking acceleration (m/s^2): ``R_turn = s^2 / a_b``.
+    """
     turns = []
     for w, point in enumerate(points[:-1]):
         before = points[w - 1] if w else start
@@ -92,7 +124,15 @@ def turns(points: list[np.ndarray], speeds: list[float], start: np.ndarray | Non
 
 
 def flown(scenario, gains):
-    """The run's initial arrays, and each leg's points, speeds and planned start (:func:`_planned`)."""
+    """The run's initial arrays, and each leg's points, speeds and planned start (:func:`_planned`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario with a ``[navigation]`` table.
+    gains : ndarray
+        ``K`` of the law: ``K_V / K_P`` is the lead of ``P*`` (N4).
+    """
     from tmem.world.initial import build
 
     initial = build(scenario)

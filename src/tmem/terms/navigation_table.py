@@ -1,17 +1,15 @@
-"""The ``[navigation]`` table: a group's mission as timed legs, and the loop that flies it.
+"""The ``[navigation]`` table: a group's mission as timed legs, and the loop that flies it::
 
-```toml
-[navigation]
-bandwidth = 0.5            # 1/s, the group's velocity loop (N2)
-share = 0.5                # of interaction.c_max, the most the mission may ask of the set-point
+    [navigation]
+    bandwidth = 0.5            # 1/s, the group's velocity loop (N2)
+    share = 0.5                # of interaction.c_max, the most the mission may ask of the set-point
 
-[[navigation.legs]]
-time = 0.0
-action = "route"           # "goto", "route", "velocity" or "hold"
-waypoints = [[300.0, 0.0], [300.0, 300.0]]
-speed = 5.0                # m/s: one for the route, or one per waypoint
-avoid = true               # plan the route around the [[obstacles]]
-```
+    [[navigation.legs]]
+    time = 0.0
+    action = "route"           # "goto", "route", "velocity" or "hold"
+    waypoints = [[300.0, 0.0], [300.0, 300.0]]
+    speed = 5.0                # m/s: one for the route, or one per waypoint
+    avoid = true               # plan the route around the [[obstacles]]
 
 A leg starts at its ``time`` and lasts until the next one; before the first, the group flies free.
 ``goto`` flies to ``target`` at ``speed``, and holds there; ``route`` flies through ``waypoints``
