@@ -9,6 +9,8 @@ modules here import no compiler: a term's kernel is compiled when a run binds it
 
 * :mod:`tmem.terms.pull` — a pull of every agent towards a point, the worked example of a term;
 * :mod:`tmem.terms.olfati_saber` — Olfati-Saber's flocking law (IEEE TAC 2006): α-, β- and γ-agents;
+* :mod:`tmem.terms.vasarhelyi` — Vásárhelyi's flocking law (Science Robotics 2018): repulsion,
+  alignment, shill agents, self-propulsion;
 * :mod:`tmem.terms.flocking` — the two flocking laws' compiled functions (loaded when a run binds one).
 """
 
@@ -22,6 +24,7 @@ from functools import cache
 TERMS: dict[str, str] = {
     "pull": "tmem.terms.pull:Pull",
     "olfati_saber": "tmem.terms.olfati_saber:OlfatiSaber",
+    "vasarhelyi": "tmem.terms.vasarhelyi:Vasarhelyi",
 }
 
 
