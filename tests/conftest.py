@@ -28,7 +28,7 @@ MODULE_KINDS = {
     "unit": ["test_kernels", "test_interaction", "test_coupling", "test_metrics", "test_coverage"],
     "physics": [
         "test_model", "test_control", "test_reference", "test_settling", "test_paper_results", "test_engine",
-        "test_terms", "test_swarm", "test_gas", "test_sensing", "test_sensing_runs", "test_batch",
+        "test_terms", "test_flocking_laws", "test_swarm", "test_gas", "test_sensing", "test_sensing_runs", "test_batch",
         "test_agent_controller", "test_checkpoint", "test_quadrotor", "test_quadrotor_runs",
         "test_flight_controller", "test_wind", "test_ground_robot", "test_physical_bounds",
     ],
