@@ -122,8 +122,9 @@ def _push(i, k, known, agents, box, law):
     """Agent ``i``'s u_i (module text) as a set-point (F1), saturated at ``c_max``, added to ``agents.setpoint[i]``."""
     n_axes = len(box)
     u = law.work
-    for a in range(n_axes):  # the γ-agent (OS 24)
-        u[i, 0, a] = -law.c1 * (known[i, a, 0] - law.q_r[a]) - law.c2 * (known[i, a, 1] - law.p_r[a])
+    for a in range(n_axes):  # the γ-agent (OS 24), its point to the nearest periodic image
+        offset = nearest_image(known[i, a, 0] - law.q_r[a], box[a])  # noqa: F821  (bound)
+        u[i, 0, a] = -law.c1 * offset - law.c2 * (known[i, a, 1] - law.p_r[a])
     for j in range(known.shape[0]):
         if j != i and agents.active[j]:
             _alpha(i, j, known, box, law)
