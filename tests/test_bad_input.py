@@ -113,6 +113,7 @@ n = 7
 
 SWARM_CASES = {
     "formation with repulsion": (SWARM.replace('"improved"', '"repulsion"'), "formation", "'switching' (10) or"),
+    "formation with the law off": (SWARM.replace('"improved"', '"none"'), "formation", "'switching' (10) or"),
     "formation without n": (SWARM.replace("n = 7", ""), "formation.n", "is required"),
     "ring of two": (SWARM.replace('"hex"', '"ring"').replace("n = 7", "n = 2"), "formation.n", "at least 3"),
     "planar formation on one axis": (SWARM.replace("axes = 2", "axes = 1"), "formation.kind", "2 or 3 axes"),

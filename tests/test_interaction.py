@@ -106,7 +106,7 @@ def test_coupled_attraction_has_no_range_limit():
 
 
 def test_uses_coupling():
-    assert [interaction.uses_coupling(name) for name in interaction.FUNCTION_NAMES] == [False, False, True, True]
+    assert [interaction.uses_coupling(name) for name in interaction.FUNCTION_NAMES] == [False, False, True, True, False]
 
 
 # Every registered function, checked for what the method needs of any interaction function and for
@@ -116,13 +116,16 @@ FINE = np.linspace(-2 * REACH, 2 * REACH, 160_001)
 
 
 @pytest.mark.parametrize("row", ROWS)
-def test_every_function_is_saturated_odd_and_repels_when_close(row):
+def test_every_function_is_saturated_odd_and_repels_when_close_unless_it_pushes_nothing(row):
     for f_en in (0, 1) if row.couples else (0,):
         u = f(row.name, FINE, f_en)
         assert np.all(np.abs(u) <= C_MAX)
         np.testing.assert_array_equal(u, -f(row.name, -FINE, f_en))  # odd to the bit: see test_odd_in_d_and_saturated
     close = np.linspace(0.01, 5.0, 50)
-    assert np.all(f(row.name, close, 0) < 0)  # pushes apart (U < 0 for d > 0) when nearly touching
+    if row.pushes:
+        assert np.all(f(row.name, close, 0) < 0)  # pushes apart (U < 0 for d > 0) when nearly touching
+    else:  # "none", the law off: nothing anywhere, coupled or not
+        assert not np.any(f(row.name, FINE, 0)) and not np.any(f(row.name, FINE, 1))
 
 
 @pytest.mark.parametrize("row", ROWS)

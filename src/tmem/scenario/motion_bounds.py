@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from tmem.law.interaction.registry import uses_coupling
+from tmem.law.interaction.registry import pushes, uses_coupling
 from tmem.scenario.bounds import SMALL_ANGLE_ERROR, SMALL_ANGLE_TILT, Doubt, peak_tilt, stopping_speed
 from tmem.scenario.tables import FieldError
 
@@ -166,12 +166,18 @@ def _check_speeds(scenario: Scenario) -> list[Doubt]:
         return []
     ia, dt, doubts = scenario.interaction, scenario.simulation.dt, []
     walled = scenario.space.walls or bool(scenario.obstacles)
-    farthest = max(ia.reach, scenario.wall_reach) if walled else ia.reach  # the farthest anything acts on an agent
-    said = f"R + R_j = {ia.reach:g} m" + (f" and R + R_w = {scenario.wall_reach:g} m" if walled else "")
+    reaches = {"R + R_j": ia.reach} if pushes(ia.function) else {}  # "none": the law holds no pair apart
+    reaches |= {"R + R_w": scenario.wall_reach} if walled else {}
+    if not reaches:
+        return []
+    farthest = max(reaches.values())  # the farthest anything acts on an agent
+    said = " and ".join(f"{name} = {reach:g} m" for name, reach in reaches.items())
     if v * dt >= farthest:
         raise FieldError(field, f"{what} {v:.4g} m/s, {v * dt:.4g} m in one step of dt = {dt:g} s: not less than "
                          f"{said}, the farthest anything acts on an agent; between two steps they may pass "
                          f"through all of it (at most {farthest / dt:.4g} m/s)")  # fmt: skip
+    if "R + R_j" not in reaches:
+        return doubts
     if v * dt >= ia.reach:
         doubts.append(Doubt(field, f"{what} {v:.4g} m/s, {v * dt:.4g} m in one step of dt = {dt:g} s: not less than "
                             f"R + R_j = {ia.reach:g} m, they may pass through each other between two steps"))  # fmt: skip

@@ -7,7 +7,11 @@ record, the step loop adds the terms' pushes agent by agent in the order of :dat
 (:mod:`tmem.engine.terms`), and checkpoints save their records; none of them names a term.  The
 modules here import no compiler: a term's kernel is compiled when a run binds it.
 
-* :mod:`tmem.terms.pull` — a pull of every agent towards a point, the worked example of a term.
+* :mod:`tmem.terms.pull` — a pull of every agent towards a point, the worked example of a term;
+* :mod:`tmem.terms.olfati_saber` — Olfati-Saber's flocking law (IEEE TAC 2006): α-, β- and γ-agents;
+* :mod:`tmem.terms.vasarhelyi` — Vásárhelyi's flocking law (Science Robotics 2018): repulsion,
+  alignment, shill agents, self-propulsion;
+* :mod:`tmem.terms.flocking` — the two flocking laws' compiled functions (loaded when a run binds one).
 """
 
 from __future__ import annotations
@@ -19,6 +23,8 @@ from functools import cache
 #: The agent terms, ``scenario table -> "module:Class"``, in the order their pushes are added.
 TERMS: dict[str, str] = {
     "pull": "tmem.terms.pull:Pull",
+    "olfati_saber": "tmem.terms.olfati_saber:OlfatiSaber",
+    "vasarhelyi": "tmem.terms.vasarhelyi:Vasarhelyi",
     "navigation": "tmem.terms.navigation:Navigation",
 }
 

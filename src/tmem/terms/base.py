@@ -24,11 +24,78 @@ A term provides, as class attributes and methods (:mod:`tmem.terms.pull` is a wo
 * :attr:`AgentTerm.steers_group` — whether it sets the group's mean motion (a mission): the speed
   synchronisation (S2) then damps the pairs' relative motion without holding their mean square
   speed (S3), which would fight every change of speed the term asks for (``interaction.keep_energy``).
+
+A term that gathers over every agent (``local = False``) reads ``known[j]``, each agent's state as
+it measures its own, not the messages between agents: the flocking laws refuse the sensing effects
+between agents that would not reach them (:func:`check_gathered_knowledge`); the navigation takes
+``known`` as what the group broadcasts (:mod:`tmem.terms.navigation`).  :func:`surroundings` and :func:`acceleration_per_input` give a record the
+walls, the obstacles and the vehicle's set-point per unit of acceleration.
 """
 
 from __future__ import annotations
 
 from typing import Any, ClassVar, NamedTuple
+
+import numpy as np
+
+from tmem.scenario.fields import FieldError
+
+#: The ``[sensing]`` keys of what agents measure of each other (messages), which a gathering term does not read.
+BETWEEN_AGENTS = ("position_noise", "velocity_noise", "delay", "period", "loss", "range")
+
+
+def check_gathered_knowledge(scenario: Any, name: str) -> None:
+    """Refuse, for the term ``[name]`` that gathers over every agent, a ``[sensing]`` effect between agents.
+
+    The term reads every agent's state as that agent measures its own (``known``; own noise
+    included); a neighbour's noise, delay, period, loss and range act on the messages the TMEM
+    law's pairs read, and would not reach it.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The whole scenario.
+    name : str
+        The term's table.
+    """
+    sensing = scenario.sensing
+    if sensing is None:
+        return
+    for key in BETWEEN_AGENTS:
+        value = getattr(sensing, key)
+        if (max(sensing.delays) if key == "delay" else value) not in (None, 0.0):
+            raise FieldError(f"sensing.{key}", f"{value} acts on what agents measure of each other, which [{name}] "
+                             "does not read: it gathers every agent's own measured state (own_position_noise, "
+                             "own_velocity_noise)")  # fmt: skip
+
+
+def surroundings(scenario: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``(walls, obstacles)``: the walled box's sides (shape (axes,), 0 where an axis has no walls) and
+    each ``[[obstacles]]`` circle's centre and radius (m, shape (obstacles, axes + 1)), as the gas holds them.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The whole scenario.
+    """
+    space = scenario.space
+    walls = np.asarray(space.box, dtype=float) if space.walls else np.zeros(space.axes)
+    obstacles = np.array([o.center + [o.radius] for o in scenario.obstacles], dtype=float).reshape(-1, space.axes + 1)
+    return walls, obstacles
+
+
+def acceleration_per_input(scenario: Any) -> float:
+    """The horizontal acceleration (m/s^2) one unit of the scenario's vehicle's set-point gives
+    (:meth:`tmem.vehicles.base.VehicleModel.acceleration_per_input`: ``g`` for a tilting multirotor).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The whole scenario: its ``[model]`` (and ``[wind]``).
+    """
+    from tmem.vehicles import vehicle_model
+
+    return vehicle_model(scenario.model, scenario.wind).acceleration_per_input()
 
 
 class AgentTerm:

@@ -1,4 +1,4 @@
-"""Interaction functions of a pair of agents: (8), Fig. 3, (10) and (11).
+"""Interaction functions of a pair of agents: (8), Fig. 3, (10) and (11), and ``"none"`` (the law off).
 
 * :mod:`tmem.law.interaction.registry` — the list of functions and what each
   claims (no compiled code: the scenario schema reads it);
@@ -10,9 +10,9 @@
 
 from __future__ import annotations
 
-from tmem.law.interaction.registry import FUNCTION_NAMES, FUNCTIONS, InteractionFunction, code, uses_coupling
+from tmem.law.interaction.registry import FUNCTION_NAMES, FUNCTIONS, InteractionFunction, code, pushes, uses_coupling
 
-__all__ = ["FUNCTIONS", "FUNCTION_NAMES", "InteractionFunction", "code", "evaluate", "uses_coupling"]
+__all__ = ["FUNCTIONS", "FUNCTION_NAMES", "InteractionFunction", "code", "evaluate", "pushes", "uses_coupling"]
 
 
 def __getattr__(name: str):

@@ -23,6 +23,8 @@ Notation, with ``reach = R + R_j``::
   on [d_t, b], K_P (r - d_t) closer than d_t; f2 as in (10).  f1 is
   continuous, and f1 = f2 for ``r <= d_t``, so coupling at ``r = d_t``
   causes no jump in control.
+* none:               0 at any distance: the TMEM law off, so that an agent
+  term (a flocking law of :mod:`tmem.terms`) acts alone.
 
 The paper writes the saturation as ``max(s_d C_max, .)``; it is read here as
 ``|U| <= c_max`` with the sign set by the function.  ``K_P`` is the modal gain
@@ -171,6 +173,18 @@ def improved_switching(r, f_en, p):
     else:
         u = _overlap(r, p)
     return _saturate(u, p.c_max)
+
+
+@numba.njit(cache=True, inline="always")
+def no_push(r, f_en, p):
+    """The function ``"none"``: 0 at any distance, the TMEM law off.
+
+    Parameters
+    ----------
+    r, f_en, p
+        As every kernel takes them (module text); all unused.
+    """
+    return 0.0
 
 
 #: The docstring of :func:`pair_control` and of each branch it is composed of.

@@ -1,4 +1,4 @@
-"""The interaction functions tmem knows, one row each: (8), Fig. 3, (10) and (11).
+"""The interaction functions tmem knows, one row each: (8), Fig. 3, (10), (11), and ``"none"`` (the law off).
 
 This module is the one list of functions.  The scenario schema takes its
 choices from it, :func:`tmem.law.interaction.kernels.pair_control` dispatches on
@@ -33,6 +33,9 @@ class InteractionFunction:
         Whether it is continuous in ``|d|`` while uncoupled (``F_en = 0``).
     summary : str
         One line for the documentation's table.
+    pushes : bool
+        Whether it pushes at all: ``False`` for ``"none"``, the TMEM law off, so that a scenario can
+        run an agent term alone (a flocking law of :mod:`tmem.terms`).
     """
 
     name: str
@@ -41,6 +44,7 @@ class InteractionFunction:
     couples: bool
     continuous: bool
     summary: str
+    pushes: bool = True
 
 
 FUNCTIONS: tuple[InteractionFunction, ...] = (
@@ -52,6 +56,8 @@ FUNCTIONS: tuple[InteractionFunction, ...] = (
                         summary="repulsion (8) while uncoupled; K_P (d - s_d d_t) at any distance while coupled"),
     InteractionFunction("improved", "improved_switching", "(11)", couples=True, continuous=True,
                         summary="a continuous f1 equal to f2 closer than d_t; f2 of (10) while coupled"),
+    InteractionFunction("none", "no_push", "the law off", couples=False, continuous=True, pushes=False,
+                        summary="0 at any distance: no pair pushes, so that an agent term (a flocking law) acts alone"),
 )  # fmt: skip
 
 #: The names, in the order of their integer codes.
@@ -67,6 +73,17 @@ def code(name: str) -> int:
         A name in :data:`FUNCTION_NAMES`.
     """
     return FUNCTION_NAMES.index(name)
+
+
+def pushes(name: str) -> bool:
+    """False for ``"none"``, the function that pushes nothing (the TMEM law off).
+
+    Parameters
+    ----------
+    name : str
+        A name in :data:`FUNCTION_NAMES`.
+    """
+    return FUNCTIONS[code(name)].pushes
 
 
 def uses_coupling(name: str) -> bool:
