@@ -146,7 +146,7 @@ def page_data(view: View) -> dict:
         "headline": headline(view.summary),
         "caveat": caveat(view.summary),
         "note": view.note,
-    }
+    } | ({} if view.route is None else {"route": view.route})
 
 
 def _import_map() -> str:
