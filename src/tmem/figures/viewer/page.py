@@ -30,7 +30,7 @@ VIEW_MARK = "written by tmem view"
 MODULES = {
     "three": ("vendor", "three.module.min.js"),
     "three/addons/OrbitControls": ("vendor", "OrbitControls.js"),
-    **{f"tmem/{name}": ("web", f"{name}.js") for name in ("run", "edges", "axes", "scene", "charts", "main")},
+    **{f"tmem/{name}": ("web", f"{name}.js") for name in ("run", "edges", "axes", "route", "scene", "charts", "main")},
 }
 #: The licences of the libraries inlined, appended to the page.
 LICENCES = ("LICENSE.three.txt", "LICENSE.uPlot.txt")
