@@ -390,3 +390,12 @@ def test_each_leg_starts_where_the_group_was_and_legs_without_points_are_left_ou
     assert route == {"legs": [{"time": 1.5, "action": "goto", "from": [31.0, 1.0], "points": [[50.0, 50.0]]}],
                      "goal": [50.0, 50.0]}  # fmt: skip
 
+
+def test_the_headline_shows_the_safety_figures_given():
+    safety = {"radius": 2.0, "min_separation": 12.345, "near_misses": 3, "min_obstacle_clearance": None}
+    shown = dict(headline({"safety": safety}))
+    assert shown["min separation"] == "12.35 m" and shown["near misses (< 2.00 m)"] == "3"
+    assert "min obstacle clearance" not in shown
+    assert dict(headline({"safety": safety | {"radius": None, "min_obstacle_clearance": 0.5}}))["min obstacle clearance"] == "0.50 m"
+    assert "near misses" in dict(headline({"safety": {"near_misses": 0}}))
+    assert len(headline({"safety": None})) == len(headline({})) == 6
