@@ -310,3 +310,93 @@ def test_the_shipped_libraries_are_the_ones_the_docs_name():
     assert "three.js r170 and uPlot 1.6.32" in template
     for script in ("uPlot.iife.min.js",):  # inlined as a classic script
         assert not re.search(r"</script|<!--", (VENDOR / script).read_text(), re.I)
+
+
+ROUTE = """name = "route3"
+[space]
+axes = 2
+[interaction]
+function = "repulsion"
+[[agents]]
+position = [0.0, 0.0]
+[[agents]]
+position = [60.0, 0.0]
+[[agents]]
+position = [0.0, 60.0]
+[[obstacles]]
+center = [40.0, 80.0]
+radius = 5.0
+[navigation]
+[[navigation.legs]]
+time = 0.0
+action = "route"
+waypoints = [[30.0, 20.0], [30.0, 40.0]]
+speed = 2.0
+[simulation]
+dt = 0.01
+duration = 4.0
+"""
+
+
+@pytest.fixture(scope="module")
+def mission_run(tmp_path_factory):
+    """A run of :data:`ROUTE`, simulated, its files written as ``tmem run`` writes them (without figures)."""
+    import tmem
+    from tmem.analysis.metrics import summarize
+    from tmem.files.io import write_netcdf
+
+    directory = tmp_path_factory.mktemp("mission")
+    trajectory = tmem.simulate(tmem.loads(ROUTE))
+    write_netcdf(trajectory, directory / "trajectory.nc")
+    (directory / "summary.json").write_text(json.dumps(summarize(trajectory)))
+    return directory
+
+
+def test_a_mission_s_route_goal_and_obstacles_are_in_the_page(mission_run, tmp_path):
+    import tmem
+    from tmem.terms.navigation_plan import planned_points
+
+    shown = embedded(write_view(mission_run, tmp_path / "view.html"))
+    waypoints = [[30.0, 20.0], [30.0, 40.0]]  # the scenario's: a route without avoid is flown as written
+    assert [points.tolist() for _, _, points in planned_points(tmem.loads(ROUTE))] == [waypoints]
+    [leg] = shown["route"]["legs"]
+    assert (leg["time"], leg["action"], leg["points"]) == (0.0, "route", waypoints)
+    np.testing.assert_allclose(leg["from"], [20.0, 20.0])  # the three agents' centre at the start
+    assert shown["route"]["goal"] == [30.0, 40.0]
+    assert shown["space"]["obstacles"] == [{"center": [40.0, 80.0], "radius": 5.0}]
+
+
+def test_a_run_without_navigation_has_no_route(tmp_path):
+    assert "route" not in embedded(write_view(write_run(tmp_path / "run"), tmp_path / "view.html"))
+
+
+def test_each_leg_starts_where_the_group_was_and_legs_without_points_are_left_out():
+    """A velocity leg (no point), a goto from 1.5 s (from the flying agents' centre at 1 s, the last
+    frame before it) and a hold where the group is (no point): one leg, whose target is the goal."""
+    import tmem
+    from tmem.figures.viewer.data import mission_route
+
+    legs = ROUTE.split("[[navigation.legs]]")[0] + "".join(
+        f"[[navigation.legs]]\ntime = {t}\naction = {json.dumps(a)}\n{keys}\n"
+        for t, a, keys in ((0.0, "velocity", "velocity = [1.0, 0.0]"), (1.5, "goto", "target = [50.0, 50.0]\nspeed = 2.0"),
+                           (3.0, "hold", ""))  # fmt: skip
+    )
+    scenario = tmem.loads(legs + "[simulation]\ndt = 0.01\nduration = 4.0\n")
+    time = np.array([0.0, 1.0, 2.0, 3.0])
+    position = np.arange(4)[:, None, None] + np.array([[0.0, 0.0], [60.0, 0.0], [0.0, 90.0]])
+    status = np.full((4, 3), FLYING, np.uint8)
+    status[1, 2] = REMOVED
+    route = mission_route(scenario, time, position, status)
+    assert route == {"legs": [{"time": 1.5, "action": "goto", "from": [31.0, 1.0], "points": [[50.0, 50.0]]}],
+                     "goal": [50.0, 50.0]}  # fmt: skip
+
+
+def test_the_headline_shows_the_safety_figures_given():
+    safety = {"radius": 2.0, "min_separation": 12.345, "near_misses": 3, "min_obstacle_clearance": None}
+    shown = dict(headline({"safety": safety}))
+    assert shown["min separation"] == "12.35 m" and shown["near misses (< 2.00 m)"] == "3"
+    assert "min obstacle clearance" not in shown
+    cleared = dict(headline({"safety": safety | {"radius": None, "min_obstacle_clearance": 0.5}}))
+    assert cleared["min obstacle clearance"] == "0.50 m" and cleared["near misses"] == "3"
+    assert "near misses" in dict(headline({"safety": {"near_misses": 0}}))
+    assert len(headline({"safety": None})) == len(headline({})) == 6

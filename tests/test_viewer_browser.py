@@ -27,6 +27,7 @@ from tmem.files.io import write_run
 from tmem.scenario import load
 from tmem.figures.viewer import write_view
 from tmem.figures.viewer.data import read_view
+from test_viewer import ROUTE
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = Path(os.environ.get("TMEM_CHROMIUM", "/usr/bin/chromium"))
@@ -35,11 +36,13 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-ne
 VIEWPORT = {"width": 1400, "height": 860}
 AGENT = (31, 119, 180)  # the agents' colour, #1f77b4
 REMOVED = (127, 127, 127)
+GOAL, ROUTE_LINE = (214, 39, 40), (44, 160, 44)  # #d62728, #2ca02c
 SCENARIOS = {
     "hex19": lambda: load(ROOT / "examples" / "swarm" / "hex19.toml"),
     "gas3d": lambda: load(ROOT / "examples" / "swarm" / "gas3d.toml"),
     "ring8_loss": lambda: load(ROOT / "examples" / "swarm" / "ring8_loss.toml"),
     "fig9": lambda: tmem.preset("fig9"),
+    "route3": lambda: tmem.loads(ROUTE),
 }
 
 
@@ -359,3 +362,22 @@ def test_the_3d_view_names_each_axis_with_its_range(open_view, runs, tmp_path):
         low = min(positions[..., k].min(), 0.0) - radius  # the page's frame: every position and the box, R beyond
         high = max(positions[..., k].max(), box[k]) + radius
         assert texts[axis] == f"{axis}, m: {low:.0f} to {high:.0f}"
+
+
+def test_a_mission_shows_its_route_goal_and_obstacle(open_view, runs, tmp_path):
+    viewer = open_view(write_view(runs("route3"), tmp_path / "route3.html"))
+    for entry in ("#legend-obstacle", "#legend-route", "#legend-goal"):
+        assert viewer.page.is_visible(entry), entry
+    image = viewer.screenshot(tmp_path / "route3.png")
+    box = viewer.page.locator("#view canvas").bounding_box()
+
+    def around(point, half):
+        x, y = np.array(viewer.js(f"tmemViewer.project({point})")) + [box["x"], box["y"]]
+        return image[int(y) - half : int(y) + half + 1, int(x) - half : int(x) + half + 1]
+
+    assert pixels_near(around([30.0, 40.0], 12), GOAL, tolerance=30) > 40  # the goal's ring
+    assert pixels_near(around([30.0, 25.0], 3), ROUTE_LINE, tolerance=20) > 5  # on the way between the waypoints
+    obstacle = around([40.0, 80.0], 2).reshape(-1, 3)  # the obstacle's middle: light grey
+    assert (np.ptp(obstacle, axis=1) < 8).all() and (obstacle < 240).all() and (obstacle > 180).all()
+    plain = open_view(write_view(runs("hex19"), tmp_path / "hex19.html"))
+    assert plain.js("tmemViewer.run.route === undefined") and not plain.page.is_visible("#legend-route")

@@ -3,7 +3,8 @@
 The page (:mod:`tmem.figures.viewer.page`) shows the run in 1-D, 2-D or 3-D: the
 agents, their interaction spheres (circles in 1-D and 2-D) of radius ``R`` on
 demand, the formation edges coloured by strain ``(|d| - d_t) / d_t`` on a
-scale fitted to the run, removed agents as grey crosses where they stopped; a
+scale fitted to the run, removed agents as grey crosses where they stopped, the
+obstacles, and a mission's route and goal (a scenario with ``[navigation]``); a
 time slider, play/pause and a speed control; the RMS velocity and the pair
 distances in panels linked to the time shown.  Agents are numbered from 1, as
 in the paper.  Large runs are thinned (:mod:`tmem.figures.viewer.data`) and the page

@@ -89,6 +89,8 @@ class View:
         ``summary.json`` as read (:func:`tmem.analysis.metrics.summarize`).
     note : str
         What is shown of the run, when it was thinned; empty when everything is.
+    route : dict or None
+        The mission's legs and goal (:func:`mission_route`); None without ``[navigation]``.
     """
 
     name: str
@@ -111,6 +113,7 @@ class View:
     d_t: list[float]
     summary: dict = field(default_factory=dict)
     note: str = ""
+    route: dict | None = None
 
 
 def read_view(run_dir: str | Path, max_agents: int = MAX_AGENTS, max_frames: int | None = None) -> View:
@@ -230,6 +233,8 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
             pair_distance=pair_distance,
             d_t=[float(v) for v in np.unique(d_t)[:3]],
         )
+        if scenario.navigation is not None:
+            view.route = mission_route(scenario, view.time, position, status)
     view.note = thinning_note(len(agents), n_agents, len(frames), n_times, len(edges), len(_edges_between(ids[agents], pairs)))
     return view
 
@@ -294,6 +299,44 @@ def _pair_series(distance: np.ndarray, pairs: np.ndarray) -> tuple[list[str], np
         return [f"agents {i + 1}–{j + 1}" for i, j in pairs], distance
     envelope = np.stack([distance.min(axis=1), np.median(distance, axis=1), distance.max(axis=1)], axis=1)
     return [f"smallest of {len(pairs)} pairs", "median", "largest"], envelope
+
+
+def mission_route(scenario, time: np.ndarray, position: np.ndarray, status: np.ndarray) -> dict:
+    """The mission as flown (:func:`tmem.terms.navigation_plan.planned_points`), as the page draws it.
+
+    Each leg with points (``velocity`` legs and a ``hold`` where the group is have none) starts where
+    the group was when it began: the centre of the agents flying at the last frame shown at or before
+    its start (the first frame for a leg that starts before it), None when none flies then.  The goal
+    is the last point of the last leg with points.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The run's scenario, with a ``[navigation]`` table.
+    time : ndarray, shape (F,)
+        The frames' times (s).
+    position : ndarray, shape (F, A, axes)
+        The agents' positions at those frames (m).
+    status : ndarray of uint8, shape (F, A)
+        Each agent's state code at those frames.
+
+    Returns
+    -------
+    dict
+        ``legs``: each leg's ``time`` (s), ``action``, ``from`` (the group's centre, m, or None) and
+        ``points`` (m); ``goal``: a point (m), or None when no leg has one.
+    """
+    from tmem.terms.navigation_plan import planned_points
+
+    legs = []
+    for start, action, points in planned_points(scenario):
+        if len(points) == 0:
+            continue
+        f = max(int(np.searchsorted(time, start, side="right")) - 1, 0)
+        flying = status[f] == FLYING
+        centre = position[f, flying].mean(axis=0).tolist() if flying.any() else None
+        legs.append({"time": float(start), "action": action, "from": centre, "points": points.tolist()})
+    return {"legs": legs, "goal": legs[-1]["points"][-1] if legs else None}
 
 
 def _space(scenario) -> dict:

@@ -30,7 +30,7 @@ VIEW_MARK = "written by tmem view"
 MODULES = {
     "three": ("vendor", "three.module.min.js"),
     "three/addons/OrbitControls": ("vendor", "OrbitControls.js"),
-    **{f"tmem/{name}": ("web", f"{name}.js") for name in ("run", "edges", "axes", "scene", "charts", "main")},
+    **{f"tmem/{name}": ("web", f"{name}.js") for name in ("run", "edges", "axes", "route", "scene", "charts", "main")},
 }
 #: The licences of the libraries inlined, appended to the page.
 LICENCES = ("LICENSE.three.txt", "LICENSE.uPlot.txt")
@@ -72,8 +72,12 @@ def quantised(values: np.ndarray, axis_last: bool = True) -> dict:
     return {"low": low.tolist(), "step": step.tolist(), "data": _b64(q, "<u2")}
 
 
+def _given(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _number(value, form: str, unit: str = "") -> str:
-    return "—" if not isinstance(value, (int, float)) or isinstance(value, bool) else form.format(value) + unit
+    return form.format(value) + unit if _given(value) else "—"
 
 
 def headline(summary: dict) -> list[tuple[str, str]]:
@@ -81,7 +85,9 @@ def headline(summary: dict) -> list[tuple[str, str]]:
 
     ΔRMS, from the start to the end, is marked ``*`` where it swings (:func:`tmem.analysis.caveats.swings`,
     explained by :func:`caveat`); "largest ΔRMS" is the change from the start with the largest
-    magnitude on the way, and when (``rms_change_peak_percent``, ``rms_change_peak_time``).
+    magnitude on the way, and when (``rms_change_peak_percent``, ``rms_change_peak_time``).  A
+    ``safety`` dict adds the smallest separation, the near misses (closer than its ``radius``) and the
+    smallest clearance to an obstacle, each where it is given (not None).
 
     Parameters
     ----------
@@ -100,7 +106,19 @@ def headline(summary: dict) -> list[tuple[str, str]]:
     ]
     if isinstance(pairs, list) and pairs:
         rows.append(("pairs coupled at end", f"{_number(summary.get('pairs_coupled_at_end'), '{:d}')}/{len(pairs)}"))
-    return rows
+    return rows + _safety(summary.get("safety"))
+
+
+def _safety(safety) -> list[tuple[str, str]]:
+    """The headline's rows of ``summary["safety"]``: those of its figures that are given."""
+    if not isinstance(safety, dict):
+        return []
+    radius = safety.get("radius")
+    within = f" (< {radius:.2f} m)" if _given(radius) else ""
+    rows = [("min separation", _number(safety.get("min_separation"), "{:.2f}", " m")),
+            ("near misses" + within, _number(safety.get("near_misses"), "{:d}")),
+            ("min obstacle clearance", _number(safety.get("min_obstacle_clearance"), "{:.2f}", " m"))]  # fmt: skip
+    return [(label, text) for label, text in rows if text != "—"]
 
 
 def caveat(summary: dict) -> str:
@@ -146,7 +164,7 @@ def page_data(view: View) -> dict:
         "headline": headline(view.summary),
         "caveat": caveat(view.summary),
         "note": view.note,
-    }
+    } | ({} if view.route is None else {"route": view.route})
 
 
 def _import_map() -> str:

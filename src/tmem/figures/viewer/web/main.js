@@ -34,6 +34,12 @@ function fillLegend() {
   $('legend-agent').style.background = COLOURS.agent;
   $('legend-removed').style.color = COLOURS.removed;
   $('legend-removed').parentElement.hidden = !run.status.includes(REMOVED);
+  $('legend-obstacle').hidden = !run.space.obstacles.length;
+  Object.assign($('legend-obstacle').firstElementChild.style, { background: COLOURS.obstacle, opacity: 0.35 });
+  $('legend-route').hidden = !run.route;
+  $('legend-route').firstElementChild.style.background = COLOURS.route;
+  $('legend-goal').hidden = !run.route?.goal;
+  $('legend-goal').firstElementChild.style.borderColor = COLOURS.goal;
   $('legend-strain').hidden = run.E === 0;
   $('strain-bar').style.background = gradient;
   $('strain-low').textContent = `−${pct(run.strainScale)}`;
@@ -171,6 +177,8 @@ window.tmemViewer = {
   // The axes' text drawn over the view: {axis, value (null for a name), text, x, y} (px in the view).
   axes() { return scene ? scene.axisTexts.map((t) => ({ ...t })) : []; },
   spheresShown() { return Boolean(scene?.spheres.visible && scene.spheres.count); },
+  // Screen position (px in the view) of a world point, given by its coordinates (one per axis).
+  project(values) { return scene ? scene.project(values) : null; },
   cursors() { return charts.cursorPositions(); },
   timing,
   readyMs: performance.now(),

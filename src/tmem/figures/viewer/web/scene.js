@@ -1,15 +1,18 @@
 // The swarm drawn with three.js: agents, interaction spheres (circles in 1-D and 2-D) of radius R,
-// formation edges coloured by strain, removed agents, the box and obstacles; orbit (3-D) or pan
-// (1-D, 2-D) and zoom; agent numbers and the agent under the pointer; the axes: in 1-D and 2-D a
-// grid with its values along the edges of the view, in 3-D each axis named along the frame.
+// formation edges coloured by strain, removed agents, the box and obstacles, a mission's route and
+// goal; orbit (3-D) or pan (1-D, 2-D) and zoom; agent numbers and the agent under the pointer; the
+// axes: in 1-D and 2-D a grid with its values along the edges of the view, in 3-D each axis named
+// along the frame.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls';
 import { edgeQuads, STRAIN_COLOURS, strainColour } from 'tmem/edges';
 import { FLYING, REMOVED, WAITING } from 'tmem/run';
+import { ROUTE_COLOURS, routeObjects, routePoints } from 'tmem/route';
 import { axisTexts, gridArea, gridPoints, placeTexts, visibleArea } from 'tmem/axes';
 
 export const COLOURS = {
   agent: '#1f77b4', removed: '#7f7f7f', sphere: '#1f77b4', frame: '#b8b8b8', box: '#555555', obstacle: '#999999',
+  ...ROUTE_COLOURS,
   ...STRAIN_COLOURS,
 };
 // Most agents labelled with their numbers.
@@ -29,6 +32,11 @@ function sprite(draw) {
 }
 
 const DOT = () => sprite((g) => { g.beginPath(); g.arc(32, 32, 28, 0, 2 * Math.PI); g.fill(); });
+const RING = () => sprite((g) => {
+  g.lineWidth = 10;
+  g.beginPath(); g.arc(32, 32, 25, 0, 2 * Math.PI); g.stroke();
+  g.beginPath(); g.arc(32, 32, 8, 0, 2 * Math.PI); g.fill();
+});
 const CROSS = () => sprite((g) => {
   g.lineWidth = 12;
   g.beginPath(); g.moveTo(10, 10); g.lineTo(54, 54); g.moveTo(54, 10); g.lineTo(10, 54); g.stroke();
@@ -86,6 +94,7 @@ export class Scene {
     for (let f = 0; f < F; f++) for (let a = 0; a < A; a++) if (status[f * A + a] !== WAITING) box.expandByPoint(this.at(f, a, p));
     if (space.box) box.expandByPoint(new THREE.Vector3()).expandByPoint(this.#point(space.box));
     for (const o of space.obstacles) box.expandByPoint(this.#point(o.center));
+    for (const p of routePoints(this.run.route)) box.expandByPoint(this.#point(p));
     if (box.isEmpty()) box.expandByPoint(new THREE.Vector3());
     return box.expandByScalar(radius);
   }
@@ -141,6 +150,16 @@ export class Scene {
       this.scene.add(mesh);
     }
     this.sphereGeometry = D === 3 ? new THREE.SphereGeometry(radius, 24, 16) : new THREE.CircleGeometry(radius, 64);
+    if (this.run.route) this.#drawRoute(this.run.route);
+  }
+
+  // The route: in 1-D and 2-D below the agents and their edges.
+  #drawRoute(route) {
+    const at = (values) => this.#point(values).setZ(this.run.D === 3 ? values[2] : -0.3);
+    const marks = (count, size, ring, colour) => points(count, size, ring ? RING() : DOT(), colour);
+    const objects = routeObjects(route, at, marks);
+    this.routeLines = objects[0];
+    this.scene.add(...objects);
   }
 
   #rectangle(box) {
@@ -274,7 +293,7 @@ export class Scene {
     if (!w || !h) return;
     this.renderer.setSize(w, h);
     const pixels = this.renderer.getDrawingBufferSize(new THREE.Vector2());
-    for (const edges of [this.coupledEdges, this.looseEdges]) {
+    for (const edges of [this.coupledEdges, this.looseEdges, this.routeLines].filter(Boolean)) {
       edges.material.uniforms.resolution.value.copy(pixels);
       edges.material.uniforms.width.value = 2.5 * this.renderer.getPixelRatio();
     }
@@ -287,6 +306,11 @@ export class Scene {
     }
     this.camera.updateProjectionMatrix();
     this.render();
+  }
+
+  // Screen position (CSS px in the canvas) of a world point given by its coordinates (one per axis).
+  project(values) {
+    return this.#onScreen(this.#point(values)).slice(0, 2);
   }
 
   // Screen position (CSS px in the canvas) of agent column a at the frame shown.
