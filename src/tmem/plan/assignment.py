@@ -4,14 +4,14 @@ Concurrent assignment and planning of trajectories (CAPT; Turpin, Michael and Ku
 agents of equal radius ``R`` in open space:
 
 1. **Assignment.**  Start ``i`` goes to goal ``phi(i)``, the one-to-one map that minimises the sum
-   of squared distances ``sum_i |g_phi(i) - s_i|^2`` (the paper's cost, the squared distances), solved as a
-   linear assignment problem (:func:`scipy.optimize.linear_sum_assignment`, Crouse 2016 [2]_).  There may
-   be more goals than starts (``N <= M``); the unused goals stay empty.
+   of squared distances ``sum_i |g_phi(i) - s_i|^2`` (CAPT's cost), solved as a linear assignment
+   problem (:func:`scipy.optimize.linear_sum_assignment`, Crouse 2016 [2]_).  There may be more
+   goals than starts (``N <= M``); the unused goals stay empty.
 2. **Trajectories.**  Every agent flies the straight line to its goal on the same clock,
    ``x_i(t) = (1 - beta(t)) s_i + beta(t) g_phi(i)``, where ``beta`` rises from 0 to 1 over
    ``[0, T]`` with zero velocity at both ends (:data:`PROFILES`).
-3. **Guarantee** (the paper's safety theorem for centralised CAPT).  If every two starts and every two
-   goals are more than ``2 sqrt(2) R`` apart, every two agents stay more than ``2 R`` apart all the
+3. **Guarantee** (the paper's safety theorem for centralised CAPT).  If every two starts and every
+   two goals are more than ``2 sqrt(2) R`` apart, every two agents stay more than ``2 R`` apart all the
    way.  Why, in two lines: the optimal assignment cannot be improved by swapping two goals, so
    ``a . c >= 0`` for ``a = s_i - s_j`` and ``c = g_phi(i) - g_phi(j)``; then
    ``|(1 - beta) a + beta c|^2 >= ((1 - beta)^2 + beta^2) Delta^2 >= Delta^2 / 2`` for separation
@@ -26,7 +26,8 @@ References
    trajectories for multiple robots", The International Journal of Robotics Research 33(1),
    98-112 (2014), doi:10.1177/0278364913515307.
 .. [2] D. F. Crouse, "On implementing 2D rectangular assignment algorithms", IEEE Transactions on
-   Aerospace and Electronic Systems 52(4), 1679-1696 (2016) (the algorithm of SciPy's solver).
+   Aerospace and Electronic Systems 52(4), 1679-1696 (2016), doi:10.1109/TAES.2016.140952 (the
+   algorithm of SciPy's solver).
 """
 
 from __future__ import annotations
@@ -38,9 +39,10 @@ import numpy as np
 __all__ = ["PROFILES", "assign", "assignment_cost", "capt_clearance", "capt_duration", "capt_safe", "capt_trajectory"]
 
 #: The time scalings ``beta(tau)``, ``tau = t / T`` in [0, 1], with beta(0) = 0, beta(1) = 1 and
-#: beta'(0) = beta'(1) = 0: each row is (coefficients of beta in powers of tau from tau^0,
-#: the largest ``|d beta / d tau|``, the largest ``|d^2 beta / d tau^2|``).  ``"cubic"``: 3 tau^2 - 2 tau^3, peak slope
-#: 3/2 at tau = 1/2, peak curvature 6 at both ends (the acceleration jumps at start and end).
+#: beta'(0) = beta'(1) = 0: each row is (coefficients of beta in powers of tau from tau^0, the
+#: largest ``|d beta / d tau|``, the largest ``|d^2 beta / d tau^2|``).  ``"cubic"`` (the default):
+#: 3 tau^2 - 2 tau^3, peak slope 3/2 at tau = 1/2, peak curvature 6 at both ends (the acceleration
+#: jumps at start and end).
 #: ``"quintic"``: 10 tau^3 - 15 tau^4 + 6 tau^5 (zero acceleration at both ends too), peak slope
 #: 15/8 at tau = 1/2, peak curvature 10/sqrt(3) at tau = 1/2 -+ sqrt(3)/6.
 PROFILES: dict[str, tuple[tuple[float, ...], float, float]] = {
