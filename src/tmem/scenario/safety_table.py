@@ -46,17 +46,19 @@ class SafetyParams(StrictModel):
 
 def closing_speed_limit(scenario: Scenario) -> float | None:
     """(M1): the fastest two agents may close and still stop outside the safety radius (m/s); ``None``
-    where the radius lies beyond the repulsion's reach, or the model's input is not a tilt.
+    where the radius lies beyond the repulsion's reach, the TMEM law is off, or the model's input is not a tilt.
 
     Parameters
     ----------
     scenario : Scenario
         Its ``[safety]`` radius, reach, tilt limit and model.
     """
+    from tmem.law.interaction.registry import pushes
+
     model, safety = scenario.model, scenario.safety
     room = scenario.interaction.reach - safety.radius
     g = getattr(model, "g", None)
-    if room <= 0.0 or g is None:
+    if room <= 0.0 or g is None or not pushes(scenario.interaction.function):
         return None
     return math.sqrt(4.0 * g * scenario.interaction.c_max * room)
 
@@ -70,7 +72,11 @@ def check_safety(scenario: Scenario) -> list[tuple[str, str]]:
     scenario : Scenario
         A scenario with a ``[safety]`` table, its tables valid on their own.
     """
+    from tmem.law.interaction.registry import pushes
+
     safety = scenario.safety
+    if not pushes(scenario.interaction.function):  # the TMEM law off: an agent term keeps agents apart, or nothing
+        return []
     if safety.radius >= scenario.interaction.reach:
         raise FieldError("safety.radius", f"{safety.radius:g} m is not inside the repulsion's reach R + R_j = "
                          f"{scenario.interaction.reach:g} m: nothing keeps agents apart at it")  # fmt: skip
