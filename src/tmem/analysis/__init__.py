@@ -4,6 +4,8 @@
 * :mod:`tmem.analysis.rms` — the RMS velocity at the start, at the end, and its largest change on the way;
 * :mod:`tmem.analysis.observables` — the gas's pressure, temperature, encounter rate, mean free path;
 * :mod:`tmem.analysis.coverage` — the share of a walled box the swarm visits;
+* :mod:`tmem.analysis.field_metrics` — the flocking literature's figures: order, near misses, groups, connectivity ...;
+* :mod:`tmem.analysis.safety` — those figures in the summary, where a scenario has a ``[safety]`` table;
 * :mod:`tmem.analysis.reference` — the same closed loop integrated in continuous time, to test the engine against.
 """
 

@@ -8,6 +8,8 @@ record, the step loop adds the terms' pushes agent by agent in the order of :dat
 modules here import no compiler: a term's kernel is compiled when a run binds it.
 
 * :mod:`tmem.terms.pull` — a pull of every agent towards a point, the worked example of a term;
+* :mod:`tmem.terms.navigation` — a group flying a mission (N1)-(N5), its table in
+  :mod:`tmem.terms.navigation_table` and its planning in :mod:`tmem.terms.navigation_plan`;
 * :mod:`tmem.terms.olfati_saber` — Olfati-Saber's flocking law (IEEE TAC 2006): α-, β- and γ-agents;
 * :mod:`tmem.terms.vasarhelyi` — Vásárhelyi's flocking law (Science Robotics 2018): repulsion,
   alignment, shill agents, self-propulsion;
