@@ -4,6 +4,7 @@ closing-speed limit (M1) against the pair's own stopping distance."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -71,3 +72,17 @@ def test_a_run_without_the_table_has_no_safety_figures():
 def test_a_bad_safety_key_is_refused_in_one_line(change, message):
     with pytest.raises(ScenarioError, match=message):
         with_changes(tmem.loads(HEAD_ON.format(c_max=0.1, speed=1.0)), change)
+
+
+def test_a_random_swarm_with_a_minimum_spacing_starts_that_far_apart_and_refuses_what_cannot_fit():
+    """Against brute force over every pair of the 400 starts."""
+    from scipy.spatial.distance import pdist
+
+    from tmem.world.initial import build
+
+    scenario = tmem.load(Path(__file__).parent.parent / "examples" / "swarm" / "gas_thermostat.toml")
+    starts = build(with_changes(scenario, {"swarm.min_spacing": 5.0})).state[:, :, 0]
+    assert len(starts) == 400 and pdist(starts).min() >= 5.0
+    assert pdist(build(scenario).state[:, :, 0]).min() < 5.0  # without it, closer: the test could fail
+    with pytest.raises(ScenarioError, match=r"^swarm\.min_spacing: 400 points cannot be 500 m apart"):
+        with_changes(scenario, {"swarm.min_spacing": 500.0})

@@ -40,12 +40,14 @@ class Agent(StrictModel):
 
 
 class SwarmParams(StrictModel):
-    """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``."""
+    """A random swarm: ``n`` agents uniform in ``region``, random velocities, from ``seed``; with
+    ``min_spacing`` (m), no two closer than that (Poisson-disk sampling, :mod:`tmem.plan.starts`)."""
 
     n: Annotated[int, Field(ge=2)]
     seed: Annotated[int, Field(ge=0)] = 0
     region: list[Positive] | None = None
     speed_rms: NonNegative = 0.0
+    min_spacing: Positive | None = None
 
 
 def check_agents(scenario: Scenario, axes: int) -> None:

@@ -309,6 +309,13 @@ class _Scenario(StrictModel):
             if covered > 0.5 * math.prod(region):
                 raise FieldError("obstacles", "with the walls' reach they cover more than half the swarm's region: "
                                  "there is no room to place it")  # fmt: skip
+        if self.swarm.min_spacing is not None:
+            from tmem.world.initial import spaced_swarm
+
+            try:  # the draw itself: the starts a run takes, or the one line that says why there are none
+                spaced_swarm(self, inset, np.asarray(region, dtype=float))
+            except ValueError as error:
+                raise FieldError("swarm.min_spacing", str(error)) from None
 
     def _check_sampling(self) -> None:
         """The gains must not underflow, and dt must resolve the closed loop A - B K (roots (5))."""

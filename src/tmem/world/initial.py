@@ -80,7 +80,10 @@ def _random_swarm(scenario: Scenario, axes: int) -> np.ndarray:
     inset = scenario.wall_reach if scenario.space.walls else 0.0
     region = np.asarray(swarm.region or np.asarray(scenario.space.box) - 2.0 * inset, dtype=float)
     state = np.zeros((swarm.n, axes, 4))
-    state[:, :, 0] = inset + rng.uniform(0.0, 1.0, (swarm.n, axes)) * region
+    if swarm.min_spacing is not None:
+        state[:, :, 0] = spaced_swarm(scenario, inset, region)
+    else:
+        state[:, :, 0] = inset + rng.uniform(0.0, 1.0, (swarm.n, axes)) * region
     # Agents within reach of an obstacle are drawn again until clear of every one (the obstacles
     # cover at most half the region: Scenario checks it).
     while len(near := np.flatnonzero(_near_obstacle(state[:, :, 0], scenario.obstacles, scenario.wall_reach))):
@@ -103,6 +106,38 @@ def _scattered(places: np.ndarray, f, axes: int) -> np.ndarray:
     scattered = np.empty_like(places)
     scattered[assign(starts, places)] = starts
     return scattered
+
+
+def spaced_swarm(scenario: Scenario, inset: float, region: np.ndarray) -> np.ndarray:
+    """A swarm's starts ``swarm.min_spacing`` apart in its region and clear of every obstacle's reach:
+    a Poisson-disk sample (:func:`tmem.plan.starts.spaced_points`), the points near an obstacle left out.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its ``[swarm]`` and obstacles.
+    inset : float
+        The region's offset from the origin on every axis (m): the walls' reach in a walled box.
+    region : ndarray, shape (axes,)
+        The region's sides (m).
+
+    Raises
+    ------
+    ValueError
+        Where the region holds fewer such starts than the swarm's agents.
+    """
+    from tmem.plan.starts import spaced_points
+
+    swarm = scenario.swarm
+    wanted = swarm.n
+    for _ in range(8):  # each round asks for as many more as fell near an obstacle
+        points = spaced_points(wanted, np.full(len(region), inset), inset + region, swarm.min_spacing, swarm.seed)
+        clear = points[~_near_obstacle(points, scenario.obstacles, scenario.wall_reach)]
+        if len(clear) >= swarm.n:
+            return clear[: swarm.n]
+        wanted += swarm.n - len(clear)
+    raise ValueError(f"the region holds {len(clear)} starts {swarm.min_spacing:g} m apart clear of the obstacles, "
+                     f"fewer than the swarm's {swarm.n}")  # fmt: skip
 
 
 def _near_obstacle(positions: np.ndarray, obstacles, reach: float) -> np.ndarray:
