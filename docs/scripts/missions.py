@@ -71,13 +71,13 @@ def route() -> None:
 
 
 def obstacles() -> None:
-    """The hex to a goal 1.3 km away through 20 random fields of 10 obstacles in a corridor 300 m wide."""
+    """The hex to a goal 1.6 km away through 20 random fields of 10 obstacles in a corridor 300 m wide."""
     from tmem.plan.fields import random_discs
 
     base = tmem.load(EXAMPLES / "hex19_obstacles.toml")
     scenarios = []
     for seed in SEEDS:
-        centres, radii = random_discs(10, [150.0, -150.0], [1150.0, 150.0], (20.0, 60.0), gap=10.0, seed=seed)
+        centres, radii = random_discs(10, [300.0, -150.0], [1300.0, 150.0], (20.0, 60.0), gap=10.0, seed=seed)
         scenarios.append(with_changes(base, {"obstacles": [{"center": c.tolist(), "radius": float(r)} for c, r in zip(centres, radii)]}))
     runs = _run_all(scenarios)
     clearance = [r["safety"]["min_obstacle_clearance"] for r in runs]
