@@ -137,7 +137,7 @@ def test_each_agent_corrected_position_uses_its_own_gains():
     state = rng.normal(size=(n, axes, 4))
     gains = rng.uniform(0.5, 2.0, size=(n, 4))
     agents = Agents(state, state.copy(), np.ones(n, dtype=np.bool_), np.empty((n, axes, 2)), np.ones((n, axes)), np.zeros((n, 0)), np.zeros((n, 0)))
-    law = Law(gains, 0, 0, False, False, 0.2, 0, 0.05, 0, 0.0)
+    law = Law(gains, 0, 0, False, False, 0.2, 0, 0.05, 0, 0.0, True)
     run = Run(10, 1, (0.0,) * axes, False, 1.0)
     neighbours = Neighbours(np.empty((0, 2), dtype=np.uint32), 0, 0, np.zeros(2, dtype=np.int64), np.zeros((n, axes)),
                             np.empty(1), np.empty(2), np.full(1, np.inf), np.empty((2, 2 * axes + 1, 8)))  # fmt: skip

@@ -243,6 +243,6 @@ def test_a_group_sent_round_an_obstacle_keeps_every_agent_out_of_its_reach():
 
 
 def test_a_goal_inside_an_obstacles_clearance_is_refused_in_one_line():
-    with pytest.raises(ScenarioError, match=r"navigation\.legs\[0\]\.avoid: .*goal.* \(clearance 75\.8\d* m, \(N4\)\)"):
+    with pytest.raises(ScenarioError, match=r"navigation\.legs\[0\]\.avoid: .*goal.* \(clearance 77\.8\d* m, \(N4\)\)"):
         with_changes(tmem.loads(AROUND), {"navigation.legs": [
             {"time": 0.0, "action": "goto", "target": [300.0, 80.0], "speed": 5.0, "avoid": True}]})

@@ -43,11 +43,13 @@ velocity kept is the one about the group's mean motion, which a settled formatio
 ``[[obstacles]]`` (:func:`tmem.plan.route.plan_route`: a visibility graph over the circles grown
 by the clearance), from where the leg before it ends (the group's centre at the start, for the first)::
 
-    clearance = r_group + (R + R_w) + s K_V / K_P                                           (N4)
+    clearance = r_group + (R + R_w) + s K_V / K_P + R_turn (1 / cos(pi / 16) - 1)               (N4)
 
 ``r_group`` the group's largest distance from its centre at the start, ``R + R_w`` the obstacles'
-reach (W1), and ``s K_V / K_P`` how far ``P*`` (6) leads ``P`` at the speed ``s``: no agent's ``P*``
-comes within an obstacle's reach, so (W1) never pushes and no pair's flag is touched by an obstacle.
+reach (W1), ``s K_V / K_P`` how far ``P*`` (6) leads ``P`` at the speed ``s``, and the depth by which
+the turn's arc (``R_turn = s^2 / a_b``) cuts into a corner of the 16-gon the route rounds each
+obstacle with: no agent's ``P*`` comes within an obstacle's reach, so (W1) never pushes and no pair's
+flag is touched by an obstacle.
 
 **Assembly.**  An ``assemble`` leg flies each agent of a ``[formation]`` on its own straight line from
 where it starts, ``f_i``, to its place ``p_i`` in the shape (assigned by CAPT when the agents are
@@ -72,7 +74,7 @@ import numpy as np
 
 from tmem.scenario.tables import FieldError
 from tmem.terms.base import AgentTerm
-from tmem.terms.navigation_plan import flown, places, turns
+from tmem.terms.navigation_plan import braking, flown, places, turns
 from tmem.terms.navigation_table import NavigationParams
 
 #: Kinds of leg, as the kernel reads them.
@@ -159,12 +161,10 @@ def navigation_record(settings: NavigationParams, scenario, gains) -> Navigated:
     gains : ndarray
         ``K`` of the law: ``K_V / K_P`` is the lead of ``P*`` (N4).
     """
-    from tmem.vehicles import vehicle_class
-
     axes = scenario.space.axes
     initial, legs = flown(scenario, gains)
     u_max = settings.share * scenario.interaction.c_max
-    a_b = 0.5 * u_max * vehicle_class(scenario.model.kind)(scenario.model).acceleration_per_input()
+    a_b = braking(scenario)
     n, n_law = initial.state.shape[0], len(gains)
     waypoint, speed, turn, first, stop, span = [], [], [], [], [], []
     place = np.full((n, axes), np.nan)

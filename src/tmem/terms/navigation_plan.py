@@ -18,9 +18,25 @@ if TYPE_CHECKING:
 
 #: The waypoint rows of a ``hold`` without a target: where the group is when the leg starts.
 HERE = np.nan
+#: The sides of the polygon a route plans round each obstacle with (:func:`tmem.plan.route.plan_route`).
+SIDES = 16
 
 
-def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: float, lead: float):
+def braking(scenario) -> float:
+    """``a_b`` of (N3), half of what the mission may ask: ``share c_max`` times the vehicle's acceleration per input (m/s^2).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its ``[navigation]`` share, tilt limit and vehicle.
+    """
+    from tmem.vehicles import vehicle_class
+
+    per_input = vehicle_class(scenario.model.kind)(scenario.model).acceleration_per_input()
+    return 0.5 * scenario.navigation.share * scenario.interaction.c_max * per_input
+
+
+def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: float, lead: float, a_b: float):
     """Each leg's points, speeds and planned start (None where the group's place is not known then: after
     a velocity leg), the avoiding legs' routes planned around the obstacles (N4)."""
     obstacles = np.array([o.center for o in scenario.obstacles], dtype=float).reshape(-1, scenario.space.axes)
@@ -37,11 +53,12 @@ def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: f
                 raise FieldError(f"navigation.legs[{k}].avoid", "follows a velocity leg: there is no point to plan from")
             from tmem.plan.route import plan_route
 
-            clearance = r_group + scenario.wall_reach + lead * max(speeds)
+            fastest = max(speeds)  # the turn's arc cuts into a corner of the polygon by R_turn (1/cos(pi/m) - 1)
+            clearance = r_group + scenario.wall_reach + lead * fastest + fastest**2 / a_b * (1 / np.cos(np.pi / SIDES) - 1)
             routed, routed_speeds, origin = [], [], here
             for point, speed in zip(points, speeds):
                 try:
-                    path = plan_route(origin, point, obstacles, radii, clearance)
+                    path = plan_route(origin, point, obstacles, radii, clearance, SIDES)
                 except ValueError as error:
                     raise FieldError(f"navigation.legs[{k}].avoid", f"{error} (clearance {clearance:.4g} m, (N4))") from None
                 routed += list(path[1:])
@@ -139,7 +156,7 @@ def flown(scenario, gains):
     positions = initial.state[initial.active, :, 0]
     start = positions.mean(axis=0)
     r_group = float(np.max(np.linalg.norm(positions - start, axis=1))) if len(positions) else 0.0
-    return initial, _planned(scenario.navigation, scenario, start, r_group, float(gains[1] / gains[0]))
+    return initial, _planned(scenario.navigation, scenario, start, r_group, float(gains[1] / gains[0]), braking(scenario))
 
 
 def planned_points(scenario) -> list[tuple[float, str, np.ndarray]]:
