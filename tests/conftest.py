@@ -16,9 +16,16 @@ keeps that one.
 """
 
 import gc
+import signal
 from fnmatch import fnmatch
 
 import pytest
+
+# The suite plays a user's Ctrl-C on the commands it starts. Where it was itself started with SIGINT
+# ignored (a background job of a non-interactive shell), the commands would inherit that and, as
+# they should, leave it ignored: take Python's own handler back, so that they start with the default.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 KINDS = ("unit", "physics", "pins", "interface")
 
