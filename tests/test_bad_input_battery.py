@@ -154,10 +154,25 @@ for path in ("formation.n", "formation.seed", "formation.jitter", "formation.d_t
     for kind in ("negative", "nan", "string"):
         case(f"{path} {kind}", changed(FORMATION, path, BAD[kind]), path)
 
+MISSION = {**FORMATION, "navigation": {"legs": [{"time": 0.0, "action": "goto", "target": [100.0, 0.0], "speed": 2.0}]},
+           "safety": {"radius": 3.0}}  # fmt: skip
+for path, field in [("navigation.bandwidth", "navigation.bandwidth"), ("navigation.share", "navigation.share"),
+                    ("navigation.legs.0.time", "navigation.legs[0].time"), ("navigation.legs.0.speed", "navigation.legs[0].speed"),
+                    ("safety.radius", "safety.radius"), ("safety.range", "safety.range")]:  # fmt: skip
+    for kind in ("negative", "nan", "string", "huge"):
+        if kind == "huge" and path in ("navigation.legs.0.speed", "safety.range"):
+            continue  # a huge speed or range is a choice, not an error
+        case(f"{path} {kind}", changed(MISSION, path, BAD[kind]), field)
+case("navigation.legs.0.target wrong size", changed(MISSION, "navigation.legs.0.target", [1.0]), "navigation.legs[0].target")
+case("navigation.legs.0.action typo", changed(MISSION, "navigation.legs.0.action", "goto!"), "navigation.legs[0].action")
+case("formation.min_spacing without scatter", changed(MISSION, "formation.min_spacing", 30.0), "min_spacing")
+case("swarm.min_spacing too wide", changed(SWARM, "swarm.min_spacing", 150.0), "swarm.min_spacing")
+
 # -- every table x {not a table, an unknown key} -------------------------------------------------------
 
 for table, base in [("model", FIG9), ("controller", FIG9), ("interaction", FIG9), ("simulation", FIG9),
-                    ("space", FIG9), ("neighbors", FIG9), ("swarm", SWARM), ("formation", FORMATION)]:  # fmt: skip
+                    ("space", FIG9), ("neighbors", FIG9), ("swarm", SWARM), ("formation", FORMATION),
+                    ("navigation", MISSION), ("safety", MISSION)]:  # fmt: skip
     case(f"{table} not a table", changed(base, table, 3), table)
     case(f"{table} unknown key", changed(base, f"{table}.colour", 1.0), f"{table}.colour")
 for table in ("agents", "commands"):
@@ -230,7 +245,7 @@ for char in ("\x00", "\x1b", "\x07", "\x7f", "\u200b", "\n"):
     case(f"name with {char!r}", changed(FIG9, "name", f"run{char}1"), "name")
 
 
-@pytest.mark.parametrize("base", [FIG9, SWARM, FORMATION], ids=["fig9", "swarm", "formation"])
+@pytest.mark.parametrize("base", [FIG9, SWARM, FORMATION, MISSION], ids=["fig9", "swarm", "formation", "mission"])
 def test_the_bases_are_valid(base):
     tmem.scenario.loads(dump(base))
 
