@@ -54,13 +54,13 @@ def closing_speed_limit(scenario: Scenario) -> float | None:
         Its ``[safety]`` radius, reach, tilt limit and model.
     """
     from tmem.law.interaction.registry import pushes
+    from tmem.scenario.bounds import stopping_speed
 
-    model, safety = scenario.model, scenario.safety
-    room = scenario.interaction.reach - safety.radius
-    g = getattr(model, "g", None)
+    room = scenario.interaction.reach - scenario.safety.radius
+    g = getattr(scenario.model, "g", None)
     if room <= 0.0 or g is None or not pushes(scenario.interaction.function):
         return None
-    return math.sqrt(4.0 * g * scenario.interaction.c_max * room)
+    return stopping_speed(g * scenario.interaction.c_max, room)
 
 
 def check_safety(scenario: Scenario) -> list[tuple[str, str]]:

@@ -234,10 +234,11 @@ def _towards(i, leg, nav, n_axes):
     """(N3): the wanted velocity ``v_d`` towards agent ``i``'s current point, into ``nav.wanted[i]``;
     on to the next segment ``turn`` before a route's point."""
     w = nav.point_now[i]
-    while w < nav.leg_stop[leg] - 1 and segment(i, w, leg, nav, n_axes)[1] < nav.turn[w]:  # noqa: F821  (bound)
-        w += 1
-    nav.point_now[i] = w
     length, along = segment(i, w, leg, nav, n_axes)  # noqa: F821  (bound)
+    while w < nav.leg_stop[leg] - 1 and along < nav.turn[w]:
+        w += 1
+        length, along = segment(i, w, leg, nav, n_axes)  # noqa: F821  (bound)
+    nav.point_now[i] = w
     distance2 = 0.0
     for a in range(n_axes):
         distance2 += (point(i, w, nav, a) - nav.centre[i, a, 0]) ** 2  # noqa: F821  (bound)
