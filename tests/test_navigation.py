@@ -246,3 +246,13 @@ def test_a_goal_inside_an_obstacles_clearance_is_refused_in_one_line():
     with pytest.raises(ScenarioError, match=r"navigation\.legs\[0\]\.avoid: .*goal.* \(clearance 77\.8\d* m, \(N4\)\)"):
         with_changes(tmem.loads(AROUND), {"navigation.legs": [
             {"time": 0.0, "action": "goto", "target": [300.0, 80.0], "speed": 5.0, "avoid": True}]})
+
+
+def test_a_mission_faster_than_the_quadrotor_can_fly_is_refused_in_one_line():
+    """The airspeed whose drag the thrust balances at the largest lean (B3): 67.36 m/s for the Crazyflie."""
+    from pathlib import Path
+
+    scenario = tmem.load(Path(__file__).parent.parent / "examples" / "missions" / "hex19_route_quadrotor.toml")
+    with pytest.raises(ScenarioError, match=r"^navigation\.legs\[0\]\.speed: .* flies at 80 m/s through the air, more than 67\.36 m/s"):
+        with_changes(scenario, {"navigation.legs.0.speed": 80.0})
+    with_changes(scenario, {"navigation.legs.0.speed": 20.0})  # below it: accepted

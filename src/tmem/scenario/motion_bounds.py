@@ -37,7 +37,7 @@ class Speed(NamedTuple):
 
 def speeds(scenario: Scenario) -> list[Speed]:
     """The speeds ``scenario`` sets: each listed agent's velocity, a formation's, a swarm's RMS speed
-    at the start, the thermostat's and the ``temperature`` commands' RMS speeds.
+    at the start, the thermostat's and the ``temperature`` commands' RMS speeds, and a mission's.
 
     Parameters
     ----------
@@ -58,6 +58,25 @@ def speeds(scenario: Scenario) -> list[Speed]:
     for k, command in enumerate(scenario.commands):
         if command.action == "temperature" and command.value is not None:
             found.append(Speed(f"commands[{k}].value", (0.0,) * axes, command.value, "the RMS speed set"))
+    return found + _mission_speeds(scenario)
+
+
+def _mission_speeds(scenario: Scenario) -> list[Speed]:
+    """The speeds a ``[navigation]`` mission asks of its group: a leg's ``velocity``, and each ``speed`` as a
+    velocity straight into the constant wind (its direction is the route's, so the worst is taken)."""
+    nav = getattr(scenario, "navigation", None)
+    if nav is None:
+        return []
+    axes = scenario.space.axes
+    wind = np.array(scenario.wind.mean()[:axes]) if scenario.wind is not None else np.zeros(axes)
+    into = -wind / np.linalg.norm(wind) if np.any(wind) else np.eye(axes)[0]
+    found = []
+    for k, leg in enumerate(nav.legs):
+        if leg.velocity is not None:
+            found.append(Speed(f"navigation.legs[{k}].velocity", tuple(leg.velocity), 0.0, f"the mission's leg {k}"))
+        for speed in sorted(set(leg.speeds())):
+            if math.isfinite(speed):
+                found.append(Speed(f"navigation.legs[{k}].speed", tuple(speed * into), 0.0, f"the mission's leg {k}"))
     return found
 
 
