@@ -38,7 +38,7 @@ MODULE_KINDS = {
         "test_model", "test_control", "test_reference", "test_settling", "test_paper_results", "test_engine",
         "test_terms", "test_flocking_laws", "test_swarm", "test_gas", "test_sensing", "test_sensing_runs", "test_batch",
         "test_agent_controller", "test_checkpoint", "test_quadrotor", "test_quadrotor_runs",
-        "test_flight_controller", "test_wind", "test_ground_robot", "test_physical_bounds", "test_navigation", "test_safety",
+        "test_flight_controller", "test_wind", "test_ground_robot", "test_physical_bounds", "test_navigation", "test_reshape", "test_safety",
     ],
     "pins": ["test_pins"],
     "interface": [

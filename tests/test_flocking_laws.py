@@ -317,6 +317,10 @@ def test_the_vasarhelyi_pair_keeps_apart_and_aligns():
     ("vasarhelyi", {"tau": 1e-3}, "vasarhelyi.tau", "shorter than the step"),
     ("vasarhelyi", {"c_frict": 1.5}, "vasarhelyi.c_frict", "less than or equal to 1"),
     ("vasarhelyi", {"r0_shill": -1.0}, "vasarhelyi.r0_shill", "greater than or equal to 0"),
+    ("olfati_saber", {"route": [[0.0, 0.0], [50.0, 0.0]]}, "olfati_saber.route_speed", "is required with a route of 2 points"),
+    ("olfati_saber", {"route": [[0.0, 0.0]], "q_r": [1.0, 1.0]}, "olfati_saber.q_r", "is not used with a route"),
+    ("vasarhelyi", {"route": [[0.0, 0.0, 1.0]]}, "vasarhelyi.route[0]", "needs 2 values"),
+    ("vasarhelyi", {"route_speed": 2.0}, "vasarhelyi.route_speed", "is not used without a route"),
 ])  # fmt: skip
 def test_bad_parameters_are_refused_in_one_line(table, changes, field, reason):
     with pytest.raises(ScenarioError) as error:
@@ -343,3 +347,54 @@ def test_a_flocking_run_goes_on_from_its_checkpoint_to_the_same_bits(tmp_path):
     saved = stopped_after(scenario, tmp_path / "run.npz", 2.0, 4.0)
     assert not [key for key in saved.arrays if key.startswith("terms.")]
     assert_same_bits(tmem.simulate(scenario), tmem.simulate(scenario, checkpoints=Checkpoints(tmp_path / "run.npz", 2.0)))
+
+
+ROUTE = [[0.0, 0.0], [30.0, 0.0], [30.0, 40.0]]
+
+
+@pytest.mark.parametrize(("t", "where", "velocity"), [
+    (0.0, (0.0, 0.0), (5.0, 0.0)), (3.0, (15.0, 0.0), (5.0, 0.0)), (8.0, (30.0, 10.0), (0.0, 5.0)),
+    (14.0, (30.0, 40.0), (0.0, 0.0)), (60.0, (30.0, 40.0), (0.0, 0.0)),
+])  # fmt: skip
+def test_the_moving_reference_flies_its_route_at_its_speed_and_holds_the_end(t, where, velocity):
+    """Against the arc length written here: 5 m/s along 30 m then 40 m, held from 14 s on."""
+    from tmem.terms.flocking import leader, route_record
+
+    route, lengths = route_record(ROUTE, 2)
+    for a in range(2):
+        assert leader(t, route, lengths, 5.0, a) == pytest.approx((where[a], velocity[a]), abs=1e-12)
+
+
+def two_agents(table: str, settings: dict, duration: float, second: list[float]):
+    return tmem.simulate(from_dict({
+        "space": {"axes": 2}, "interaction": {"function": "none", "c_max": 0.5, "radius": 0.5, "d_t": 0.5, "eps": 0.1},
+        "simulation": {"dt": 0.01, "duration": duration, "record_every": 10},
+        "agents": [{"position": [0.0, 0.0]}, {"position": second}], table: settings,
+    }))  # fmt: skip
+
+
+def test_the_olfati_saber_gamma_agent_leads_a_pair_along_its_route():
+    """Two agents under OS 23-24 with a reference flying a straight line at 4 m/s: the γ-agent's feedback
+    has the reference's velocity as its feed-forward and the α-forces cancel in the pair's mean, so the
+    pair's centre ends on the reference, moving with it, its agents where the α-force (OS 23) balances
+    the γ-agent's pull c1 r/2 on each (a little inside the lattice's d = 7 m), solved here by brentq."""
+    from scipy.optimize import brentq
+
+    trajectory = two_agents("olfati_saber", {"c1": 0.5, "c2": 3.0, "route": [[0.0, 20.0], [2000.0, 20.0]],
+                                             "route_speed": 4.0}, 120.0, [10.0, 0.0])
+    q, v = trajectory.state[-1, :, :, 0], trajectory.state[-1, :, :, 1]
+    assert q.mean(axis=0) == pytest.approx([4.0 * 120.0, 20.0], abs=0.01)
+    assert v == pytest.approx(np.array([[4.0, 0.0], [4.0, 0.0]]), abs=0.01)
+    balance = brentq(lambda r: os_phi_alpha(os_sigma(r), 8.4, 7.0) / math.sqrt(1 + EPS * r * r) * r + 0.5 * r / 2, 3.0, 7.0)
+    assert balance < 6.9  # the pull moves it: the test tells the balance from d
+    assert np.linalg.norm(q[1] - q[0]) == pytest.approx(balance, abs=0.01)
+
+
+def test_the_vasarhelyi_goal_draws_an_agent_at_the_flocking_speed():
+    """SwarmLab's goal mode: v_d = v_flock towards the goal, so mid-way the agent flies at v_flock straight at it."""
+    trajectory = two_agents("vasarhelyi", {"route": [[300.0, 400.0]]}, 60.0, [-500.0, -500.0])  # beyond r_c
+    r = np.searchsorted(trajectory.time, 40.0)
+    q, v = trajectory.state[r, 0, :, 0], trajectory.state[r, 0, :, 1]
+    assert np.linalg.norm(v) == pytest.approx(4.0, rel=1e-3)
+    assert v / np.linalg.norm(v) == pytest.approx([0.6, 0.8], abs=1e-3)
+    assert np.linalg.norm(q) == pytest.approx(4.0 * 40.0, abs=6.0)  # it did fly there: less the velocity loop's start

@@ -187,11 +187,17 @@ def test_scattered_agents_start_at_the_places_capt_gives_them_the_least_squared_
     assert gaps.min() >= 30.0
 
 
-def test_a_scattered_hex_assembles_at_its_centre_without_a_near_miss():
+def test_a_scattered_hex_assembles_at_its_centre_each_agent_at_its_place_without_a_near_miss():
+    from tmem.world.formation import generate
+
     scenario = tmem.loads(SCATTERED)
     trajectory = tmem.simulate(scenario)
     assert np.abs(trajectory.pair_distance[-1] - 35.0).max() < 0.1
     assert np.linalg.norm(trajectory.state[-1, :, :, 0].mean(axis=0) - [10.0, -20.0]) < 0.1
+    places = generate("hex", 7, 35.0, 2, False).positions + [10.0, -20.0]  # agent k starts where CAPT sends it to place k
+    gaps = np.linalg.norm(trajectory.state[-1, :, None, :, 0] - places[None], axis=-1)
+    assert np.array_equal(gaps.argmin(axis=1), np.arange(7))  # each at its own place (the shape may turn a little:
+    assert gaps.min(axis=1).max() < 2.0  # its pairs hold distances only, and a hex turned about its centre holds them all)
     positions = trajectory.state[:, :, :, 0]  # brute force over every recorded step and pair
     gaps = np.linalg.norm(positions[:, :, None] - positions[:, None], axis=-1)[:, *np.triu_indices(7, 1)]
     assert gaps.min() > 3.0

@@ -352,7 +352,8 @@ def time_to_goal(positions: np.ndarray, times: np.ndarray, goal: np.ndarray, tol
 
 
 def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarray, active: np.ndarray | None = None, *,
-                  edges: np.ndarray | None = None, d_t: float | np.ndarray | None = None, target: np.ndarray | None = None,
+                  edges: np.ndarray | None = None, d_t: float | np.ndarray | None = None, members: np.ndarray | None = None,
+                  target: np.ndarray | None = None,
                   obstacles: tuple[np.ndarray, np.ndarray] | None = None, box: np.ndarray | None = None,
                   safety_radius: float | None = None, collision_radius: float | None = None,
                   communication_range: float | None = None, connectivity_every: int = 1,
@@ -363,6 +364,8 @@ def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarr
     ----------
     positions, velocities, times, active : the recorded arrays (module docstring); edges and shape take every agent
     edges, d_t : :func:`edge_errors`'s, optional
+    members : ndarray (records, edges), bool, optional
+        Which edges the formation holds at each record (a mission that changes its shape); the others are left out
     target : :func:`shape_distance`'s, optional
     obstacles : (centers, radii), :func:`obstacle_clearance`'s, optional
     box : :func:`wall_clearance`'s, optional
@@ -379,6 +382,8 @@ def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarr
     share = found.get("pairs_within_share", ())
     wide = communication_range is None or flying.sum(axis=1).max() > MAX_CONNECTIVITY_AGENTS
     errors = np.abs(edge_errors(p, edges, d_t)) if edges is not None else np.zeros((1, 0))
+    if members is not None:
+        errors = np.where(members, errors, np.nan)
     return {
         "order_mean": _reduce(phi[times >= (times[0] + times[-1]) / 2], np.mean), "order_min": _reduce(phi),
         "min_separation": min_separation(p, flying), "near_misses": found.get("count"),

@@ -244,18 +244,23 @@ def direction_error_deg(trajectory: Trajectory) -> float | None:
     trajectory : Trajectory
         A run (:func:`tmem.simulate`).
     """
-    direction = trajectory.initial.direction
+    n_records = len(trajectory.time)
+    direction = np.broadcast_to(trajectory.initial.direction, (n_records, *trajectory.initial.direction.shape))
+    if trajectory.scenario.shapes_change:  # each shape's own, from when it is taken
+        from tmem.terms.navigation_plan import held_pairs
+
+        direction = held_pairs(trajectory.scenario, trajectory.pairs, trajectory.time)[1]
     position = {int(a): q for q, a in enumerate(trajectory.agents)}
     worst = None
     for p, (i, j) in enumerate(trajectory.pairs.tolist()):
-        if np.isnan(direction[p, 0]) or i not in position or j not in position:
+        if np.isnan(direction[:, p, 0]).all() or i not in position or j not in position:
             continue
         where = trajectory.model.position(trajectory.state)
         delta = where[:, position[j]] - where[:, position[i]]
         box = trajectory.initial.box
         delta = np.where(box > 0, delta - box * np.round(delta / np.where(box > 0, box, 1.0)), delta)
-        cosine = (delta @ direction[p]) / np.linalg.norm(delta, axis=1)
-        angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))[trajectory.flag[:, p] == 1]
+        cosine = np.sum(delta * direction[:, p], axis=1) / np.linalg.norm(delta, axis=1)
+        angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))[(trajectory.flag[:, p] == 1) & np.isfinite(cosine)]
         if angle.size:
             worst = max(worst or 0.0, float(angle.max()))
     return worst

@@ -30,12 +30,16 @@ def _goal(scenario) -> np.ndarray | None:
 
 
 def _target(trajectory: Trajectory) -> np.ndarray | None:
-    """The formation's shape, agent by agent, where the run has a generated one and records every agent."""
+    """The formation's shape at the end, agent by agent, where the run has a generated one and records every agent."""
     from tmem.world.formation import generate
 
     scenario, f = trajectory.scenario, trajectory.scenario.formation
     if f is None or f.kind == "edges" or len(trajectory.agents) != scenario.n_agents:
         return None
+    if scenario.reshapes:
+        from tmem.terms.navigation_plan import shapes_flown
+
+        return shapes_flown(scenario)[-1].places
     return generate(f.kind, scenario.n_agents, f.d_t or scenario.interaction.d_t, scenario.space.axes, f.bearing).positions
 
 
@@ -50,6 +54,7 @@ def safety_summary(trajectory: Trajectory) -> dict | None:
     """
     from tmem.analysis.field_metrics import field_summary
     from tmem.scenario.safety_table import closing_speed_limit
+    from tmem.terms.navigation_plan import held_pairs
 
     scenario = trajectory.scenario
     safety = scenario.safety
@@ -63,6 +68,7 @@ def safety_summary(trajectory: Trajectory) -> dict | None:
         trajectory.model.position(trajectory.state), trajectory.model.velocity(trajectory.state), trajectory.time,
         trajectory.active,
         edges=trajectory.pairs if every_agent and len(trajectory.pairs) else None, d_t=trajectory.d_t,
+        members=held_pairs(scenario, trajectory.pairs, trajectory.time)[0] if every_agent and scenario.shapes_change else None,
         target=_target(trajectory),
         obstacles=(np.array([o.center for o in obstacles]), np.array([o.radius for o in obstacles])) if obstacles else None,
         box=np.asarray(scenario.space.box, dtype=float) if scenario.space.walls else None,

@@ -65,21 +65,31 @@ def record_steps(n_steps: int, record_every: int) -> np.ndarray:
 
 
 def _commands(scenario: Scenario, edges: np.ndarray, slot: np.ndarray) -> Commands:
-    """Commands as arrays: step, kind, and targets (pair indices, or the agent's slot) in rows."""
+    """Commands as arrays: step, kind, and targets (pair indices, or the agent's slot) in rows; a mission's
+    changes of shape among them, each with the direction its pairs hold (where the formation holds directions)."""
+    axes = scenario.space.axes
     index = {(int(i), int(j)): e for e, (i, j) in enumerate(edges)}
-    commands = sorted(scenario.commands, key=lambda cmd: cmd.time)
-    step = np.array([scenario.simulation.step_of(cmd.time) for cmd in commands], dtype=np.int64)
-    kind = np.array([COMMANDS.index(cmd.action) for cmd in commands], dtype=np.int64)
-    targets = []
-    for cmd in commands:
-        if cmd.agent is not None:
-            targets.append([slot[cmd.agent]])
+    timed = [(cmd.time, COMMANDS.index(cmd.action), cmd.agent, cmd.targets, cmd.value, None) for cmd in scenario.commands]
+    if scenario.shapes_change:  # the mission's changes of the pairs (tmem.terms.navigation_plan.shape_commands)
+        from tmem.terms.navigation_plan import shape_commands
+
+        timed += [(time, COMMANDS.index("reshape"), None, [tuple(edge) for edge in edges.tolist()], None, held)
+                  for time, edges, held in shape_commands(scenario)]  # fmt: skip
+    timed.sort(key=lambda command: command[0])
+    step = np.array([scenario.simulation.step_of(time) for time, *_ in timed], dtype=np.int64)
+    kind = np.array([code for _, code, *_ in timed], dtype=np.int64)
+    targets, directions = [], []
+    for _, _, agent, pairs, _, held in timed:
+        if agent is not None:
+            targets.append([slot[agent]])
         else:
-            targets.append([index[(min(i, j), max(i, j))] for i, j in cmd.targets or []])
+            targets.append([index[(min(i, j), max(i, j))] for i, j in pairs or []])
+        directions.append(np.full((len(targets[-1]), axes), np.nan) if held is None else held)
     ptr = np.cumsum([0] + [len(t) for t in targets]).astype(np.int64)
     flat = np.array([t for row in targets for t in row], dtype=np.int64)
-    value = np.array([np.nan if cmd.value is None else cmd.value for cmd in commands], dtype=float)
-    return Commands(step, kind, ptr, flat, value)
+    value = np.array([np.nan if value is None else value for *_, value, _ in timed], dtype=float)
+    direction = np.concatenate(directions) if directions else np.empty((0, axes))
+    return Commands(step, kind, ptr, flat, value, direction)
 
 
 def _records(n_steps_recorded: int, rec_agents: np.ndarray, slots: np.ndarray, n_axes: int, n_state: int, n_edges: int,

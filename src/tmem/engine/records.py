@@ -17,8 +17,9 @@ from typing import NamedTuple
 import numpy as np
 
 #: Command kinds, in the order of their integer codes.
-COMMANDS = ("uncouple", "couple", "remove", "add", "temperature")
-UNCOUPLE, COUPLE, REMOVE, ADD, TEMPERATURE = range(5)
+#: ``reshape`` is a mission's (:mod:`tmem.terms.navigation`): the listed pairs couple, every other lets go.
+COMMANDS = ("uncouple", "couple", "remove", "add", "temperature", "reshape")
+UNCOUPLE, COUPLE, REMOVE, ADD, TEMPERATURE, RESHAPE = range(6)
 #: What a chunk of the loop returns: it ran to its end, or the neighbour lists must be built first.
 DONE, LISTS_STALE = 0, -1
 
@@ -199,9 +200,10 @@ class Neighbours(NamedTuple):
 class Commands(NamedTuple):
     """The operator's commands, sorted by step; command ``c`` acts on ``target[ptr[c]:ptr[c + 1]]``.
 
-    ``target`` holds pair indices for couple / uncouple (none: every pair) and
+    ``target`` holds pair indices for couple / uncouple (none: every pair) and reshape (the new shape's pairs),
     the agent's slot for remove / add; ``value`` the set RMS velocity of a
-    temperature command (m/s; NaN for the others).
+    temperature command (m/s; NaN for the others); ``direction`` (one row per target) the unit direction
+    a reshape's pair holds from ``i`` to ``j`` (NaN rows: none, and every other command's).
     """
 
     step: np.ndarray
@@ -209,6 +211,7 @@ class Commands(NamedTuple):
     ptr: np.ndarray
     target: np.ndarray
     value: np.ndarray
+    direction: np.ndarray
 
 
 class Records(NamedTuple):

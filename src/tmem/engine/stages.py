@@ -23,7 +23,7 @@ from tmem.law.modal import corrected_position, gains_row, tilt_scale
 from tmem.world.space import nearest_image
 from tmem.engine.gas import limit_of, record_totals
 from tmem.engine.gas_counts import clear
-from tmem.engine.records import ADD, COUPLE, REMOVE, TEMPERATURE, UNCOUPLE
+from tmem.engine.records import ADD, COUPLE, REMOVE, RESHAPE, TEMPERATURE, UNCOUPLE
 
 @numba.njit(cache=True, inline="always")
 def log_event(events, counters, k, kind, i, j, action, rule):
@@ -91,6 +91,42 @@ def command_pair(k, e, kind, pairs):
 
 
 @numba.njit(cache=True)
+def reshape(k, members, direction, pairs, events, counters):
+    """A mission's change of shape at step ``k``: the pairs ``members`` (indices) couple now, armed, as pairs
+    that start coupled do (their energy rule's record and their synchronisation start afresh), each to
+    hold its row of ``direction`` (NaN: a distance only); every other pair lets go now, disarmed, and
+    pushes as an uncoupled pair (10)/(11).  Each change of flag is an event (an uncoupling's rule: ``reshape``).
+
+    Parameters
+    ----------
+    k : int
+        The step.
+    members : ndarray of int
+        The new shape's pairs.
+    direction : ndarray, shape (members, axes)
+        The unit direction each holds from ``i`` to ``j`` (NaN rows: none).
+    pairs, events, counters
+        The loop's records, changed in place.
+    """
+    for e in range(pairs.armed.shape[0]):
+        pairs.armed[e] = 0
+    for m in range(members.shape[0]):
+        pairs.armed[members[m]] = 1
+        for a in range(direction.shape[1]):
+            pairs.direction[members[m], a] = direction[m, a]
+    for e in range(pairs.armed.shape[0]):  # coupled where armed, an event at each change
+        if pairs.armed[e] != pairs.flag[e]:
+            kind = coupling.EVENT_COUPLE if pairs.armed[e] == 1 else coupling.EVENT_UNCOUPLE
+            rule = -1 if pairs.armed[e] == 1 else coupling.RELEASE_RESHAPE
+            log_event(events, counters, k, kind, pairs.i[e], pairs.j[e], -1, rule)
+        pairs.flag[e] = pairs.armed[e]
+        pairs.disarmed_at[e] = k
+        pairs.coupled_gap[e] = np.nan
+        pairs.coupled_energy[e] = np.nan
+        pairs.kept_speed2[e] = np.nan
+
+
+@numba.njit(cache=True)
 def apply_commands(k, commands, agents, pairs, events, counters, gas):
     """Carry out the commands due at step ``k``; return whether the neighbour lists must be rebuilt.
 
@@ -99,7 +135,8 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
 
     ``couple`` / ``uncouple`` arm or disarm pairs (:mod:`tmem.law.coupling`); ``remove`` stops an agent
     where it is (a lost vehicle), ``add`` puts it back at its start; ``temperature`` sets the
-    thermostat's RMS velocity (:mod:`tmem.engine.gas`).
+    thermostat's RMS velocity (:mod:`tmem.engine.gas`); ``reshape``, a mission's, sets which pairs are
+    coupled (:func:`reshape`).
 
     Parameters
     ----------
@@ -131,6 +168,10 @@ def apply_commands(k, commands, agents, pairs, events, counters, gas):
             else:
                 agents.state[i, :, 1:] = 0.0
             log_event(events, counters, k, coupling.EVENT_COMMAND, i, -1, kind, -1)
+        elif kind == RESHAPE:
+            log_event(events, counters, k, coupling.EVENT_COMMAND, -1, -1, kind, -1)
+            last = commands.ptr[c + 1]
+            reshape(k, commands.target[first:last], commands.direction[first:last], pairs, events, counters)
         elif kind == TEMPERATURE:
             gas.target2[0] = commands.value[c] * commands.value[c]
             log_event(events, counters, k, coupling.EVENT_COMMAND, -1, -1, kind, -1)

@@ -68,9 +68,10 @@ EVENT_COMMAND, EVENT_COUPLE, EVENT_UNCOUPLE = range(3)
 UNCOUPLE_RULES = ("window", "energy")
 UNCOUPLE_BY_WINDOW, UNCOUPLE_BY_ENERGY = range(2)
 #: What released a pair (an ``uncouple`` event's rule), in the order of their integer codes: (9),
-#: the energy match, (9) after the energy match was not found in time, the loss of an agent.
-RELEASES = ("window", "energy", "fallback", "lost")
-RELEASE_WINDOW, RELEASE_ENERGY, RELEASE_FALLBACK, RELEASE_LOST = range(4)
+#: the energy match, (9) after the energy match was not found in time, the loss of an agent, a mission's
+#: change of shape (:mod:`tmem.terms.navigation`).
+RELEASES = ("window", "energy", "fallback", "lost", "reshape")
+RELEASE_WINDOW, RELEASE_ENERGY, RELEASE_FALLBACK, RELEASE_LOST, RELEASE_RESHAPE = range(5)
 
 
 @numba.njit(cache=True)

@@ -177,8 +177,24 @@ class _Scenario(StrictModel):
             return np.stack([i, j], axis=1).astype(np.int64)
         if self.formation.kind == "edges":
             return np.array(sorted(sorted(e[:2]) for e in self.formation.edges), dtype=np.int64).reshape(-1, 2)
+        if self.reshapes:  # every pair of every shape the mission takes (tmem.terms.navigation_plan)
+            from tmem.terms.navigation_plan import shapes_flown
+
+            return np.unique(np.concatenate([shape.edges for shape in shapes_flown(self)]), axis=0)
         f = self.formation
         return generate(f.kind, self.n_agents, f.d_t or self.interaction.d_t, self.space.axes).edges
+
+    @property
+    def reshapes(self) -> bool:
+        """Whether a ``[navigation]`` leg changes the formation's shape in flight (``reshape``)."""
+        nav = getattr(self, "navigation", None)
+        return nav is not None and any(leg.action == "reshape" for leg in nav.legs)
+
+    @property
+    def shapes_change(self) -> bool:
+        """Whether the mission sets which pairs are coupled: an ``assemble`` or ``reshape`` leg."""
+        nav = getattr(self, "navigation", None)
+        return nav is not None and any(leg.action in ("assemble", "reshape") for leg in nav.legs)
 
     @model_validator(mode="after")
     def _consistent(self) -> "Scenario":
@@ -218,15 +234,15 @@ class _Scenario(StrictModel):
         check_memory(self, n, self._pair_count(n))  # before generating anything
         check_sensing(self, n, self.neighbors.uses_lists(n), memory_limit())
         check_wind(self)
+        for table in (self.model, *(getattr(self, name) for name in self.agent_terms)):
+            if hasattr(table, "check"):  # a vehicle's or a term's own checks against the scenario (a mission's shapes)
+                table.check(self)
         pairs = self.pairs()  # generating a large formation is not free: once per validation
         if self.simulation.record_agents == [] and not len(pairs):
             raise FieldError(
                 "simulation.record_agents", "is empty and there are no pairs to record: the run would record nothing"
             )
         check_commands(self, n, pairs)
-        for table in (self.model, *(getattr(self, name) for name in self.agent_terms)):
-            if hasattr(table, "check"):  # a vehicle's or a term's own checks against the scenario
-                table.check(self)
         check_record_size(self, n, len(pairs))
         self._check_formation_room(axes, n)
         doubts = check_vehicle(self) + check_motion(self)  # the physical bounds (docs/parameters.md, "Bounds")

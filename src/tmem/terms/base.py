@@ -38,7 +38,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-from tmem.scenario.fields import FieldError
+from tmem.scenario.fields import FieldError, per_axis
 
 #: The ``[sensing]`` keys of what agents measure of each other (messages), which a gathering term does not read.
 BETWEEN_AGENTS = ("position_noise", "velocity_noise", "delay", "period", "loss", "range")
@@ -131,3 +131,30 @@ class AgentTerm:
     def kernel(cls) -> Any:
         """The compiled push ``push(i, k, known, agents, box, record)`` (module text)."""
         raise NotImplementedError
+
+
+def check_route(name: str, route, speed, axes: int) -> None:
+    """A flocking term's moving reference: points of ``axes`` values, and a speed where it has more than one.
+
+    Parameters
+    ----------
+    name : str
+        The term's table, e.g. ``"olfati_saber"``.
+    route : list of list of float or None
+        ``route``: the reference's points (m).
+    speed : float or None
+        ``route_speed`` (m/s).
+    axes : int
+        The space's axes.
+    """
+    if route is None:
+        if speed is not None:
+            raise FieldError(f"{name}.route_speed", "is not used without a route")
+        return
+    if not route:
+        raise FieldError(f"{name}.route", "is empty: give at least one point")
+    for k, point in enumerate(route):
+        if len(point) != axes:
+            raise FieldError(f"{name}.route[{k}]", per_axis(axes, len(point)))
+    if len(route) > 1 and speed is None:
+        raise FieldError(f"{name}.route_speed", f"is required with a route of {len(route)} points: how fast the reference flies it")

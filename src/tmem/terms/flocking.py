@@ -9,8 +9,9 @@ environments", Science Robotics 3(20):eaat3536, 2018 (``docs/flocking_laws.md`` 
 * Olfati-Saber: the σ-norm (OS 8), the bump ρ_h (OS 10), σ1 and the action function φ (OS 15),
   φ_α (OS 15-16), φ_β (OS, Section VII);
 * Vásárhelyi: the braking curve D (VV);
-* shared: a neighbour's separation to its nearest periodic image, and the push of a wanted
-  acceleration on the vehicle's set-point (F1) (:func:`add_push`).
+* shared: a neighbour's separation to its nearest periodic image, the push of a wanted
+  acceleration on the vehicle's set-point (F1) (:func:`add_push`), and a mission's reference moving
+  along a route (:func:`leader`).
 
 :func:`compile_push` compiles a term's push template (a plain function of its module that calls
 these by name) with these names bound, as the step loop binds its stages
@@ -213,9 +214,54 @@ def add_push(setpoint, wanted, i, n_axes, per_input, c_max):
         setpoint[i, a] += wanted[i, 0, a]
 
 
+@numba.njit(**JIT)
+def leader(t, route, lengths, speed, a):
+    """A mission's moving reference on axis ``a`` at time ``t`` (s): ``(position, velocity)`` of a point that
+    flies the polyline ``route`` from its first point at ``speed`` and holds its last (the γ-agent of
+    OS Algorithm 2 as a virtual leader; the goal SwarmLab's Vásárhelyi law steers to, moving).
+
+    Parameters
+    ----------
+    t : float
+        Time since the start (s).
+    route : ndarray, shape (points, axes)
+        The polyline (m).
+    lengths : ndarray, shape (points,)
+        Its length from the first point to each (m), ``lengths[0] = 0``.
+    speed : float
+        The reference's speed (m/s).
+    a : int
+        The axis.
+    """
+    flown = speed * t
+    last = lengths.shape[0] - 1
+    if flown >= lengths[last]:
+        return route[last, a], 0.0
+    m = 0
+    while lengths[m + 1] <= flown:
+        m += 1
+    tangent = (route[m + 1, a] - route[m, a]) / (lengths[m + 1] - lengths[m])
+    return route[m, a] + (flown - lengths[m]) * tangent, speed * tangent
+
+
+def route_record(route, axes: int) -> tuple[np.ndarray, np.ndarray]:
+    """A reference's polyline as :func:`leader` reads it: the points (m, shape (points, axes)) and the length
+    flown to each (m).
+
+    Parameters
+    ----------
+    route : list of list of float
+        The points, the first where the reference starts.
+    axes : int
+        The space's axes.
+    """
+    points = np.asarray(route, dtype=float).reshape(-1, axes)
+    return points, np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+
+
 #: The names a term's push template calls, each bound to its compiled function here.
 NAMES = ("sigma_norm", "bump", "sigma1", "action", "phi_alpha", "phi_beta", "braking", "separation", "nearest_image",
-         "cap", "add_push")  # fmt: skip
+         "cap", "add_push", "leader")  # fmt: skip
 
 
 def compile_push(push, *helpers):

@@ -58,8 +58,18 @@ scattered, :mod:`tmem.world.initial`), all arriving together at ``T``::
     v_d,i = (p_i - f_i) beta'(t/T) / T + k_p (f_i + beta(t/T) (p_i - f_i) - P_i),  beta = 3 tau^2 - 2 tau^3   (N5)
 
 with (N2) on the agent's own state; ``T`` is the shortest that keeps every agent within the leg's
-speed and ``a_b`` (:func:`tmem.plan.assignment.capt_duration`).  From ``T`` on, the group holds the
-shape's centre by (N1)-(N3) and the pairs, coupled from the start, settle.
+speed and ``a_b`` (:func:`tmem.plan.assignment.capt_duration`).  The pairs let go when the leg starts and
+couple at ``T``, each agent at its place (:func:`tmem.terms.navigation_plan.shape_commands`); from ``T`` on,
+the group holds the shape's centre by (N1)-(N3) and the pairs settle.
+
+**Reshape.**  A ``reshape`` leg flies each agent from where it is at the leg's start ``t_0`` to its place
+``q_i`` in the new shape (CAPT from its place in the old one, :func:`tmem.terms.navigation_plan.shapes_flown`)
+about the centre ``c_0``, the lines carried at the centre's velocity ``v_0`` then (both from (N1))::
+
+    v_d,i = v_0 + (p_i - f_i) beta'(tau) / T + k_p (f_i + v_0 (t - t_0) + beta(tau) (p_i - f_i) - P_i),  p_i = c_0 + q_i   (N5')
+
+and from ``t_0 + T`` the centre flies on, ``v_d = v_0 + k_p (c_0 + v_0 (t - t_0) - c_P)``.  The pairs change as
+in an assembly, by the engine's ``reshape`` command (:func:`tmem.engine.stages.reshape`).
 
 Each agent carries its own leg, waypoint and hold point in the record (a checkpoint saves them);
 the centre costs ``O(N)`` per agent, ``O(N^2)`` per step: missions of a few thousand agents at most.
@@ -74,22 +84,25 @@ import numpy as np
 
 from tmem.scenario.tables import FieldError
 from tmem.terms.base import AgentTerm
-from tmem.terms.navigation_plan import braking, flown, places, turns
+from tmem.terms.navigation_plan import braking, flown, shape_centre, shapes_flown, turns
 from tmem.terms.navigation_table import NavigationParams
 
 #: Kinds of leg, as the kernel reads them.
-VELOCITY, POINTS, ASSEMBLE = 0, 1, 2
-KINDS = {"velocity": VELOCITY, "assemble": ASSEMBLE}
+VELOCITY, POINTS, ASSEMBLE, RESHAPE = 0, 1, 2, 3
+KINDS = {"velocity": VELOCITY, "assemble": ASSEMBLE, "reshape": RESHAPE}
 
 
 class Navigated(NamedTuple):
     """The record of (N1)-(N5): the mission as arrays, the loop's numbers, each agent's progress.
 
     ``leg_step``, ``leg_kind``, ``leg_first``, ``leg_stop``, ``leg_velocity``, ``leg_span`` (legs; the
-    span is an ``assemble`` leg's ``T`` (s)); ``place`` (each agent's place in the shape, (N5)); ``waypoint``,
-    ``speed``, ``turn`` (points: position, speed towards it, distance before it to turn); ``gain``
-    (``K_n``), ``k_p``, ``a_b``, ``u_max``, ``dt``; per agent: ``leg_now``, ``point_now``, ``leg_from``
-    (the centre when the leg started), and work space ``centre``, ``wanted``, ``push``.
+    span is an ``assemble`` or ``reshape`` leg's ``T`` (s)); ``place`` (legs, agents by slot, axes: each
+    agent's place in an ``assemble`` leg's shape, or about the centre in a ``reshape`` leg's, (N5));
+    ``waypoint``, ``speed``, ``turn`` (points: position, speed towards it, distance before it to turn);
+    ``gain`` (``K_n``), ``k_p``, ``a_b``, ``u_max``, ``dt``; per agent: ``leg_now``, ``point_now``,
+    ``leg_from`` (the centre when the leg started), ``line_from`` (the agent's own position then),
+    ``drift`` (the centre's velocity then, which a reshape moves on with), and work space ``centre``,
+    ``wanted``, ``push``.
     """
 
     leg_step: np.ndarray
@@ -110,6 +123,8 @@ class Navigated(NamedTuple):
     leg_now: np.ndarray
     point_now: np.ndarray
     leg_from: np.ndarray
+    line_from: np.ndarray
+    drift: np.ndarray
     centre: np.ndarray
     wanted: np.ndarray
     push: np.ndarray
@@ -161,33 +176,36 @@ def navigation_record(settings: NavigationParams, scenario, gains) -> Navigated:
     gains : ndarray
         ``K`` of the law: ``K_V / K_P`` is the lead of ``P*`` (N4).
     """
+    from tmem.engine.driver import slot_order
+
     axes = scenario.space.axes
     initial, legs = flown(scenario, gains)
     u_max = settings.share * scenario.interaction.c_max
     a_b = braking(scenario)
     n, n_law = initial.state.shape[0], len(gains)
-    waypoint, speed, turn, first, stop, span = [], [], [], [], [], []
-    place = np.full((n, axes), np.nan)
-    for leg, (points, speeds, here) in zip(settings.legs, legs):
+    waypoint, speed, turn, first, stop = [], [], [], [], []
+    place, span = np.full((len(legs), n, axes), np.nan), np.zeros(len(legs))
+    for k, (leg, (points, speeds, here)) in enumerate(zip(settings.legs, legs)):
         first.append(len(waypoint))
         turn += turns(points, speeds, here, a_b)
         waypoint += points
         speed += speeds
         stop.append(len(waypoint))
-        span.append(0.0)
-        if leg.action == "assemble":
-            place, span[-1] = places(scenario, leg, initial.state[:, :, 0], a_b)
+    for shape in shapes_flown(scenario)[1:] if scenario.shapes_change else []:  # an assembly's places are absolute
+        centre = shape_centre(scenario, settings.legs[shape.leg]) if settings.legs[shape.leg].action == "assemble" else 0.0
+        place[shape.leg], span[shape.leg] = shape.places + centre, shape.span
+    place = place[:, slot_order(scenario, initial, gains)]  # the kernel's agent i is the run's slot i
     velocity = np.array([leg.velocity if leg.velocity is not None else [0.0] * axes for leg in settings.legs], dtype=float)
     return Navigated(
         leg_step=np.array([scenario.simulation.step_of(leg.time) for leg in settings.legs], dtype=np.int64),
         leg_kind=np.array([KINDS.get(leg.action, POINTS) for leg in settings.legs], dtype=np.int64),
         leg_first=np.array(first, dtype=np.int64), leg_stop=np.array(stop, dtype=np.int64), leg_velocity=velocity,
-        leg_span=np.array(span, dtype=float), place=place, dt=scenario.simulation.dt,
+        leg_span=span, place=place, dt=scenario.simulation.dt,
         waypoint=np.array(waypoint, dtype=float).reshape(-1, axes), speed=np.array(speed, dtype=float),
         turn=np.array(turn, dtype=float), gain=loop_gains(scenario, settings.bandwidth), k_p=settings.bandwidth / 4.0,
         a_b=float(a_b), u_max=float(u_max), leg_now=np.full(n, -1, dtype=np.int64), point_now=np.zeros(n, dtype=np.int64),
-        leg_from=np.zeros((n, axes)), centre=np.zeros((n, axes, n_law)), wanted=np.zeros((n, axes)),
-        push=np.zeros((n, axes)),
+        leg_from=np.zeros((n, axes)), line_from=np.zeros((n, axes)), drift=np.zeros((n, axes)),
+        centre=np.zeros((n, axes, n_law)), wanted=np.zeros((n, axes)), push=np.zeros((n, axes)),
     )  # fmt: skip
 
 
@@ -260,18 +278,30 @@ def _towards(i, leg, nav, n_axes):
             nav.wanted[i, a] *= min(1.0, nav.speed[w] / np.sqrt(size2)) if size2 > 0.0 else 1.0
 
 
-def _assembling(i, k, leg, nav, n_axes):
-    """(N5): the wanted velocity of agent ``i`` on its straight line to its place, ``beta = 3 tau^2 - 2 tau^3``."""
-    tau = min(1.0, (k - nav.leg_step[leg]) * nav.dt / nav.leg_span[leg])
+def _lines(i, k, leg, nav, n_axes):
+    """(N5), (N5'): the wanted velocity of agent ``i`` on its straight line to its place, ``beta = 3 tau^2 - 2 tau^3``,
+    the line carried at the ``drift`` the group had when the leg started (a reshape's; none for an assembly)."""
+    elapsed = (k - nav.leg_step[leg]) * nav.dt
+    tau = min(1.0, elapsed / nav.leg_span[leg])
     beta, slope = tau * tau * (3.0 - 2.0 * tau), 6.0 * tau * (1.0 - tau) / nav.leg_span[leg]
     for a in range(n_axes):
-        line = nav.place[i, a] - nav.leg_from[i, a]
-        nav.wanted[i, a] = slope * line + nav.k_p * (nav.leg_from[i, a] + beta * line - nav.centre[i, a, 0])
+        place = nav.place[leg, i, a] + (nav.leg_from[i, a] if nav.leg_kind[leg] == RESHAPE else 0.0)
+        line = place - nav.line_from[i, a]
+        on_line = nav.line_from[i, a] + nav.drift[i, a] * elapsed + beta * line
+        nav.wanted[i, a] = nav.drift[i, a] + slope * line + nav.k_p * (on_line - nav.centre[i, a, 0])
+
+
+def _drifting(i, k, leg, nav, n_axes):
+    """After a reshape (N5'): the wanted velocity that carries the centre on at the group's ``drift``, from
+    where it was when the leg started (a hold where the group was at rest)."""
+    elapsed = (k - nav.leg_step[leg]) * nav.dt
+    for a in range(n_axes):
+        nav.wanted[i, a] = nav.drift[i, a] + nav.k_p * (nav.leg_from[i, a] + nav.drift[i, a] * elapsed - nav.centre[i, a, 0])
 
 
 def _push(i, k, known, agents, box, nav):
-    """(N1)-(N3) on agent ``i`` at step ``k``: the velocity loop on its estimate of the group's centre,
-    saturated at ``u_max``, added to its set-point."""
+    """(N1)-(N3), (N5) on agent ``i`` at step ``k``: the velocity loop on its estimate of the group's centre
+    (or, on an assembly's or a reshape's lines, on its own state), saturated at ``u_max``, added to its set-point."""
     leg = -1
     for m in range(nav.leg_step.shape[0]):
         if nav.leg_step[m] <= k:
@@ -280,25 +310,26 @@ def _push(i, k, known, agents, box, nav):
         return
     n_axes = len(box)
     kind = nav.leg_kind[leg]
-    if kind == ASSEMBLE and (k - nav.leg_step[leg]) * nav.dt >= nav.leg_span[leg]:
-        kind = POINTS  # placed: the group holds the shape's centre
-    if kind == ASSEMBLE:  # its own state, towards its own place
-        for a in range(n_axes):
-            for s in range(nav.centre.shape[2]):
-                nav.centre[i, a, s] = known[i, a, s]
-    else:
-        centre(i, known, agents.active, nav.centre)  # noqa: F821  (bound)
+    centre(i, known, agents.active, nav.centre)  # noqa: F821  (bound)
     if nav.leg_now[i] != leg:  # the leg starts: from here, at its first point
         nav.leg_now[i] = leg
         nav.point_now[i] = nav.leg_first[leg]
         for a in range(n_axes):
             nav.leg_from[i, a] = nav.centre[i, a, 0]
-    if kind == VELOCITY:
+            nav.line_from[i, a] = known[i, a, 0]
+            nav.drift[i, a] = nav.centre[i, a, 1] if kind == RESHAPE else 0.0
+    on_lines = (kind == ASSEMBLE or kind == RESHAPE) and (k - nav.leg_step[leg]) * nav.dt < nav.leg_span[leg]
+    if on_lines:  # its own state, towards its own place
+        for a in range(n_axes):
+            for s in range(nav.centre.shape[2]):
+                nav.centre[i, a, s] = known[i, a, s]
+        lines(i, k, leg, nav, n_axes)  # noqa: F821  (bound)
+    elif kind == VELOCITY:
         for a in range(n_axes):
             nav.wanted[i, a] = nav.leg_velocity[leg, a]
-    elif kind == ASSEMBLE:
-        assembling(i, k, leg, nav, n_axes)  # noqa: F821  (bound)
-    else:
+    elif kind == RESHAPE:
+        drifting(i, k, leg, nav, n_axes)  # noqa: F821  (bound)
+    else:  # and an assembly, placed: the group holds the shape's centre
         towards(i, leg, nav, n_axes)  # noqa: F821  (bound)
     size2 = 0.0
     for a in range(n_axes):
@@ -350,4 +381,5 @@ class Navigation(AgentTerm):
         segment = bound(_segment, "navigation_segment", options, **geometry)
         towards = bound(_towards, "navigation_towards", options, segment=segment, **geometry)
         return bound(_push, "navigation_push", options, centre=bound(_centre, "navigation_centre", options), towards=towards,
-                     assembling=bound(_assembling, "navigation_assembling", options))  # fmt: skip
+                     lines=bound(_lines, "navigation_lines", options),
+                     drifting=bound(_drifting, "navigation_drifting", options))  # fmt: skip

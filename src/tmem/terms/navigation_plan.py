@@ -1,5 +1,6 @@
 """The mission as the navigation flies it: each leg's points and speeds, routes planned around obstacles (N4),
-an assembly's places and span (N5), the turns along a route (N3).
+an assembly's or a reshape's places and span (N5), the formation's shapes and their pairs, the turns along a
+route (N3).
 
 Planning runs once, when a run's record is built (:func:`tmem.terms.navigation.navigation_record`);
 :func:`planned_points` gives the same legs to figures and the viewer.
@@ -7,7 +8,7 @@ Planning runs once, when a run's record is built (:func:`tmem.terms.navigation.n
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -47,6 +48,9 @@ def _planned(settings: NavigationParams, scenario, start: np.ndarray, r_group: f
         if leg.action == "assemble":  # then the group holds the shape's centre (N5)
             here = shape_centre(scenario, leg)
             legs.append(([here], [float(leg.speed)], None))
+            continue
+        if leg.action == "reshape":  # about the centre where it starts, moving on with the group (N5)
+            legs.append(([np.full(scenario.space.axes, HERE)], [float(leg.speed)], here))
             continue
         if leg.avoid:
             if here is None:
@@ -109,6 +113,124 @@ def places(scenario, leg, starts: np.ndarray, a_b: float) -> tuple[np.ndarray, f
     slots = generate(f.kind, len(starts), d_t, scenario.space.axes, f.bearing).positions + shape_centre(scenario, leg)
     span = capt_duration(starts, slots, np.arange(len(starts)), float(leg.speed), a_b)
     return slots, max(span, scenario.simulation.dt)
+
+
+class Shape(NamedTuple):
+    """One shape a formation takes in a mission.
+
+    Attributes
+    ----------
+    leg : int or None
+        The ``assemble`` or ``reshape`` leg that takes it (``None``: the formation's own shape, from the start).
+    places : ndarray, shape (agents, axes)
+        Each agent's place, about the shape's centre (m).
+    edges : ndarray, shape (edges, 2), int
+        The shape's pairs, ``(i, j)`` with ``i < j``, as agents.
+    span : float
+        The leg's ``T`` (s): its pairs couple at its end (0 for the first shape).
+    """
+
+    leg: int | None
+    places: np.ndarray
+    edges: np.ndarray
+    span: float
+
+
+def shapes_flown(scenario) -> list[Shape]:
+    """The formation's shapes, from its own to each ``assemble`` and ``reshape`` leg's: an assembly's places
+    are the formation's own (each agent starts where CAPT sends it to its place, :mod:`tmem.world.initial`);
+    each agent's place in a reshape's shape is the one CAPT assigns it from its place in the shape before
+    (the least sum of squared distances), and the new shape's edges join the agents placed at its
+    neighbouring slots.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario with a generated ``[formation]``; its ``[navigation]`` legs, if any.
+    """
+    from tmem.plan.assignment import assign, capt_duration
+    from tmem.world.formation import generate
+    from tmem.world.initial import formation_positions
+
+    f, n, axes = scenario.formation, scenario.n_agents, scenario.space.axes
+    d_t = scenario.interaction.d_t if f.d_t is None else f.d_t
+    first = generate(f.kind, n, d_t, axes)
+    shapes = [Shape(None, first.positions, first.edges, 0.0)]
+    legs = scenario.navigation.legs if getattr(scenario, "navigation", None) is not None else []
+    for k, leg in enumerate(legs):
+        if leg.action == "assemble":
+            shapes.append(Shape(k, first.positions, first.edges, places(scenario, leg, formation_positions(scenario), braking(scenario))[1]))
+        if leg.action != "reshape":
+            continue
+        new, before = generate(leg.shape, n, d_t, axes), shapes[-1].places
+        slot = assign(before, new.positions)  # agent a takes slot slot[a]
+        agent = np.argsort(slot)  # slot s is taken by agent agent[s]
+        edges = np.sort(agent[new.edges], axis=1)
+        edges = edges[np.lexsort((edges[:, 1], edges[:, 0]))]
+        places_now = new.positions[slot]
+        span = capt_duration(before, places_now, np.arange(n), float(leg.speed), braking(scenario))
+        shapes.append(Shape(k, places_now, edges, max(span, scenario.simulation.dt)))
+    return shapes
+
+
+def shape_commands(scenario) -> list[tuple[float, np.ndarray, np.ndarray]]:
+    """When the formation's pairs change in a mission that shapes it, and to what: ``(time (s), the pairs that
+    couple then (agents, shape (m, 2)), the direction each holds (NaN rows: a distance only))``; every other
+    pair lets go at that time (:func:`tmem.engine.stages.reshape`).
+
+    The formation's own shape at the start (its pairs coupled if ``formation.coupled``); at each ``assemble``
+    or ``reshape`` leg's start, none (the agents fly their lines free of the springs, TMEM's push keeping
+    passing agents apart); at the end of its lines, ``T`` later, the leg's shape, each agent at its place.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario whose mission assembles or reshapes its formation.
+    """
+    axes, legs = scenario.space.axes, scenario.navigation.legs
+    none = (np.empty((0, 2), dtype=np.int64), np.empty((0, axes)))
+    found = []
+    for shape in shapes_flown(scenario):
+        delta = shape.places[shape.edges[:, 1]] - shape.places[shape.edges[:, 0]]
+        held = delta / np.linalg.norm(delta, axis=1, keepdims=True) if scenario.formation.bearing else np.nan * delta
+        if shape.leg is None:
+            found.append((0.0, *((shape.edges, held) if scenario.formation.coupled else none)))
+        else:
+            found += [(legs[shape.leg].time, *none), (legs[shape.leg].time + shape.span, shape.edges, held)]
+    return found
+
+
+def held_pairs(scenario, pairs: np.ndarray, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which of ``pairs`` a formation whose mission shapes it holds at each of ``times``, and the direction
+    each holds, as :func:`shape_commands` sets them.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario whose mission assembles or reshapes its formation.
+    pairs : ndarray, shape (pairs, 2)
+        The run's pairs, ``(i, j)`` agents.
+    times : ndarray, shape (records,)
+        The recorded times (s).
+
+    Returns
+    -------
+    members : ndarray, shape (records, pairs), bool
+    directions : ndarray, shape (records, pairs, axes)
+        The unit direction from ``i`` to ``j`` (NaN where the pair is not held, or the formation holds distances only).
+    """
+    index = {(int(i), int(j)): e for e, (i, j) in enumerate(pairs)}
+    members = np.zeros((len(times), len(pairs)), dtype=bool)
+    directions = np.full((len(times), len(pairs), scenario.space.axes), np.nan)
+    sim = scenario.simulation
+    for time, edges, held in shape_commands(scenario):
+        now = times >= sim.step_of(time) * sim.dt - 1e-9
+        chosen = [index[tuple(edge)] for edge in edges.tolist()]
+        members[now] = False
+        members[np.ix_(now, chosen)] = True
+        directions[now] = np.nan
+        directions[np.ix_(now, chosen)] = held
+    return members, directions
 
 
 def turns(points: list[np.ndarray], speeds: list[float], start: np.ndarray | None, a_b: float) -> list[float]:

@@ -16,7 +16,11 @@ A leg starts at its ``time`` and lasts until the next one; before the first, the
 (the last one held); ``velocity`` holds ``velocity``; ``hold`` holds ``target``, or where the group
 is when the leg starts; ``assemble`` flies each agent of a ``[formation]`` to its place in the shape
 (centred on ``target``, by default the formation's ``center``), no faster than ``speed``, on the
-synchronised straight lines of CAPT, and holds it there.  The equations are in :mod:`tmem.terms.navigation`.
+synchronised straight lines of CAPT, and holds it there; ``reshape`` changes the formation's shape in
+flight to ``shape`` (a generated kind): each agent flies to its place in the new shape (CAPT from its
+place in the old one) about the group's centre, moving on with the group's velocity at the leg's start,
+the pairs letting go when the leg starts and those of the new shape coupling when the lines end.  The
+equations are in :mod:`tmem.terms.navigation`.
 """
 
 from __future__ import annotations
@@ -32,12 +36,13 @@ class Leg(StrictModel):
     """One leg of a mission, from ``time`` (s) to the next leg's (see the module text)."""
 
     time: NonNegative
-    action: Literal["goto", "route", "velocity", "hold", "assemble"]
+    action: Literal["goto", "route", "velocity", "hold", "assemble", "reshape"]
     target: list[Number] | None = None
     waypoints: list[list[Number]] | None = None
     speed: Positive | list[Positive] | None = None
     velocity: list[Number] | None = None
     avoid: bool = False
+    shape: Literal["chain", "ring", "triangle", "hex"] | None = None
 
     def points(self) -> list[list[float]]:
         """The leg's points: its waypoints, or its target as the one waypoint (none for ``velocity``)."""
@@ -63,10 +68,10 @@ class Leg(StrictModel):
             The space's axes.
         """
         needs = {"goto": ("target", "speed"), "route": ("waypoints", "speed"), "velocity": ("velocity",), "hold": (),
-                 "assemble": ("speed",)}  # fmt: skip
+                 "assemble": ("speed",), "reshape": ("shape", "speed")}  # fmt: skip
         used = {"goto": ("target", "speed", "avoid"), "route": ("waypoints", "speed", "avoid"), "velocity": ("velocity",),
-                "hold": ("target",), "assemble": ("target", "speed")}  # fmt: skip
-        for key in ("target", "waypoints", "speed", "velocity"):
+                "hold": ("target",), "assemble": ("target", "speed"), "reshape": ("shape", "speed")}  # fmt: skip
+        for key in ("target", "waypoints", "speed", "velocity", "shape"):
             given = getattr(self, key) is not None
             if key in needs[self.action] and not given:
                 raise FieldError(f"{where}.{key}", f"is required for {self.action}")
@@ -76,6 +81,8 @@ class Leg(StrictModel):
             raise FieldError(f"{where}.avoid", f"is not used by {self.action}")
         if self.action == "route" and not self.waypoints:
             raise FieldError(f"{where}.waypoints", "is empty: give at least one waypoint")
+        if isinstance(self.speed, list) and self.action in ("assemble", "reshape"):
+            raise FieldError(f"{where}.speed", f"is one speed for {self.action}: every agent's top speed (m/s)")
         if isinstance(self.speed, list) and len(self.speed) != len(self.points()):
             raise FieldError(f"{where}.speed", f"gives {len(self.speed)} speeds for {len(self.points())} waypoints: "
                              "give one for the route, or one per waypoint")  # fmt: skip
@@ -121,17 +128,13 @@ class NavigationParams(StrictModel):
             if k and scenario.simulation.step_of(leg.time) <= scenario.simulation.step_of(times[k - 1]):
                 raise FieldError(f"navigation.legs[{k}].time", f"must come after the leg before ({times[k - 1]:g} s), "
                                  f"at least one step dt later, got {leg.time:g}")  # fmt: skip
-            if leg.action == "assemble" and (scenario.formation is None or scenario.formation.kind == "edges"):
-                raise FieldError(f"navigation.legs[{k}].action", "'assemble' needs a [formation] of a generated kind "
-                                 "(chain, ring, triangle, hex): the shape its agents take")  # fmt: skip
-            if leg.action == "assemble" and not scenario.formation.coupled:
-                raise FieldError(f"navigation.legs[{k}].action", "'assemble' needs the pairs coupled from the start "
-                                 "(formation.coupled = true): uncoupled, the push f1 between d_t and R + R_j stops agents "
-                                 "that arrive at rest, short of the coupling window (docs/missions.md)")  # fmt: skip
-            if leg.action == "assemble" and isinstance(leg.speed, list):
-                raise FieldError(f"navigation.legs[{k}].speed", "is one speed for assemble: every agent's top speed (m/s)")
+            if leg.action in ("assemble", "reshape"):
+                self._check_shaping(k, leg, scenario)
             if leg.action == "assemble" and [other.action for other in self.legs[:k]].count("assemble"):
                 raise FieldError(f"navigation.legs[{k}].action", "a mission assembles its formation once")
+            if leg.action == "assemble" and "reshape" in [other.action for other in self.legs[:k]]:
+                raise FieldError(f"navigation.legs[{k}].action", "an assemble leg comes before any reshape: it flies "
+                                 "the agents from their starts to the formation's first shape")  # fmt: skip
             if leg.avoid and not scenario.obstacles:
                 raise FieldError(f"navigation.legs[{k}].avoid", "has no [[obstacles]] to plan around")
         loop_gains(scenario, self.bandwidth)  # refuses a bandwidth the tilt loop cannot follow
@@ -139,3 +142,15 @@ class NavigationParams(StrictModel):
             from tmem.terms.navigation_plan import planned_points
 
             planned_points(scenario)  # refuses a route that cannot clear the obstacles (N4)
+
+    @staticmethod
+    def _check_shaping(k: int, leg: Leg, scenario) -> None:
+        """An ``assemble`` or ``reshape`` leg: a generated formation, a shape its agents can take."""
+        action, f = leg.action, scenario.formation
+        where = f"navigation.legs[{k}]"
+        if f is None or f.kind == "edges":
+            raise FieldError(f"{where}.action", f"'{action}' needs a [formation] of a generated kind "
+                             "(chain, ring, triangle, hex): the shape its agents take")  # fmt: skip
+        n = scenario.n_agents
+        if leg.shape == "triangle" and n != 3 or leg.shape == "ring" and n < 3:
+            raise FieldError(f"{where}.shape", f"a {leg.shape} cannot hold the formation's {n} agents")

@@ -30,7 +30,7 @@ import numpy as np
 from pydantic import Field
 
 from tmem.scenario.fields import FieldError, NonNegative, Number, Positive, StrictModel, per_axis
-from tmem.terms.base import AgentTerm, acceleration_per_input, check_gathered_knowledge, surroundings
+from tmem.terms.base import AgentTerm, acceleration_per_input, check_gathered_knowledge, check_route, surroundings
 
 #: Where a bump starts to fall, strictly between 0 and 1 (OS 10).
 BumpStart = Annotated[float, Field(gt=0, lt=1)]
@@ -49,7 +49,10 @@ class OlfatiSaberParams(StrictModel):
       scale of the α-agents' terms, whose gains Algorithms 1-2 fix at 1);
     * ``c1`` (1/s^2), ``c2`` (1/s): the γ-agent's gains (OS 24), 0 by default (no navigation: free
       flocking, Algorithm 1); ``q_r`` (m), ``p_r`` (m/s): its fixed reference, one value per axis
-      (``q_r`` is needed with ``c1 > 0``; ``p_r`` is 0 if not given).
+      (``q_r`` is needed with ``c1 > 0``; ``p_r`` is 0 if not given); or ``route`` (m), points one
+      value per axis, and ``route_speed`` (m/s): the γ-agent as a virtual leader that flies the route
+      from its first point at that speed and holds its last (OS Algorithm 2's moving γ-agent;
+      :func:`tmem.terms.flocking.leader`).
     """
 
     d: Positive = 7.0
@@ -66,6 +69,8 @@ class OlfatiSaberParams(StrictModel):
     c2: NonNegative = 0.0
     q_r: list[Number] | None = None
     p_r: list[Number] | None = None
+    route: list[list[Number]] | None = None
+    route_speed: Positive | None = None
 
     def check(self, scenario) -> None:
         """Check the table against the scenario: ``a <= b``, a reference per axis, one with ``c1 > 0``,
@@ -84,7 +89,11 @@ class OlfatiSaberParams(StrictModel):
             value = getattr(self, name)
             if value is not None and len(value) != axes:
                 raise FieldError(f"olfati_saber.{name}", per_axis(axes, len(value)))
-        if self.c1 > 0.0 and self.q_r is None:
+        check_route("olfati_saber", self.route, self.route_speed, axes)
+        for name in ("q_r", "p_r"):
+            if self.route is not None and getattr(self, name) is not None:
+                raise FieldError(f"olfati_saber.{name}", "is not used with a route: the γ-agent starts at its first point")
+        if self.c1 > 0.0 and self.q_r is None and self.route is None:
             raise FieldError("olfati_saber.q_r", f"is required with c1 = {self.c1:g} > 0: the γ-agent (OS 24) pulls "
                              "towards it")  # fmt: skip
         check_gathered_knowledge(scenario, "olfati_saber")
@@ -93,7 +102,8 @@ class OlfatiSaberParams(StrictModel):
 class OlfatiSaberRecord(NamedTuple):
     """The record of the law: the σ-norm's ``eps``; φ's ``a``, ``b``; the bumps' ``h_alpha``, ``h_beta``;
     ``r_alpha = |r|_σ``, ``d_alpha = |d|_σ``, ``d_beta = |d'|_σ``; the gains ``c1_beta``, ``c2_beta``,
-    ``c1``, ``c2``; the reference ``q_r``, ``p_r`` (per axis); ``walls`` and ``obstacles``
+    ``c1``, ``c2``; the reference ``q_r``, ``p_r`` (per axis), or its ``route``, ``lengths`` and
+    ``route_speed`` (0: none; :func:`tmem.terms.flocking.leader`), ``dt``; ``walls`` and ``obstacles``
     (:func:`tmem.terms.base.surroundings`); ``per_input``, the set-point per m/s^2; ``c_max``; and
     ``work``, shape (agents, 3, axes): ``u_i``, ``q̂ - q_i`` and ``p̂ - p_i`` of agent ``i``."""
 
@@ -111,6 +121,10 @@ class OlfatiSaberRecord(NamedTuple):
     c2: float
     q_r: np.ndarray
     p_r: np.ndarray
+    route: np.ndarray
+    lengths: np.ndarray
+    route_speed: float
+    dt: float
     walls: np.ndarray
     obstacles: np.ndarray
     per_input: float
@@ -122,9 +136,12 @@ def _push(i, k, known, agents, box, law):
     """Agent ``i``'s u_i (module text) as a set-point (F1), saturated at ``c_max``, added to ``agents.setpoint[i]``."""
     n_axes = len(box)
     u = law.work
-    for a in range(n_axes):  # the γ-agent (OS 24), its point to the nearest periodic image
-        offset = nearest_image(known[i, a, 0] - law.q_r[a], box[a])  # noqa: F821  (bound)
-        u[i, 0, a] = -law.c1 * offset - law.c2 * (known[i, a, 1] - law.p_r[a])
+    for a in range(n_axes):  # the γ-agent (OS 24), fixed or flying its route, its point to the nearest periodic image
+        q_r, p_r = law.q_r[a], law.p_r[a]
+        if law.route_speed > 0.0:
+            q_r, p_r = leader(k * law.dt, law.route, law.lengths, law.route_speed, a)  # noqa: F821  (bound)
+        offset = nearest_image(known[i, a, 0] - q_r, box[a])  # noqa: F821  (bound)
+        u[i, 0, a] = -law.c1 * offset - law.c2 * (known[i, a, 1] - p_r)
     for j in range(known.shape[0]):
         if j != i and agents.active[j]:
             _alpha(i, j, known, box, law)
@@ -218,15 +235,17 @@ class OlfatiSaber(AgentTerm):
         gains : ndarray
             ``K`` of the law (unused).
         """
-        from tmem.terms.flocking import sigma_norm  # the run binds the compiled law: its σ-norm (OS 8) here too
+        from tmem.terms.flocking import route_record, sigma_norm  # the run binds the compiled law: its σ-norm (OS 8) here too
 
         s, axes = settings, scenario.space.axes
+        route, lengths = route_record(s.route or [[0.0] * axes], axes)
         walls, obstacles = surroundings(scenario)
         return OlfatiSaberRecord(
             eps=s.eps, a=s.a, b=s.b, h_alpha=s.h_alpha, h_beta=s.h_beta, r_alpha=sigma_norm(s.kappa * s.d, s.eps),
             d_alpha=sigma_norm(s.d, s.eps), d_beta=sigma_norm(s.beta_ratio * s.d, s.eps), c1_beta=s.c1_beta,
             c2_beta=s.c2_beta, c1=s.c1, c2=s.c2, q_r=np.asarray(s.q_r or [0.0] * axes, dtype=float),
-            p_r=np.asarray(s.p_r or [0.0] * axes, dtype=float), walls=walls, obstacles=obstacles,
+            p_r=np.asarray(s.p_r or [0.0] * axes, dtype=float), route=route, lengths=lengths,
+            route_speed=float(s.route_speed or 0.0), dt=scenario.simulation.dt, walls=walls, obstacles=obstacles,
             per_input=1.0 / acceleration_per_input(scenario), c_max=float(scenario.interaction.c_max),
             work=np.zeros((scenario.n_agents, 3, axes)),
         )  # fmt: skip

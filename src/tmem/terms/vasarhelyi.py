@@ -6,12 +6,15 @@ Methods; ``docs/flocking_laws.md`` writes the law out), as its authors' simulato
 (github:csviragh/robotsim, ``src/algo_spp_evol.c``, ``src/utilities/interactions.c``,
 ``src/utilities/math_utils.c``, ``src/robotmodel.c``).  Agent ``i`` wants the velocity::
 
-    v_d = v_flock v_i / |v_i|                                                  self-propulsion
+    v_d = v_flock v_i / |v_i|      (or v_flock (g - q_i) / |g - q_i|)          self-propulsion (or a goal g)
           + Σ_j p_rep (r0_rep - r_ij) (q_i - q_j) / r_ij         for r_ij < r0_rep, repulsion
           + Σ_j C_frict (v_ij - v_ij^max) (v_j - v_i) / v_ij     for v_ij > v_ij^max, alignment
           + Σ_s (v_is - v_is^max) (v_s - v_i) / v_is             for v_is > v_is^max, shill agents
 
-then cut to ``|v_d| <= v_max``; ``r_ij = |q_j - q_i| < R_C`` (the communication range),
+then cut to ``|v_d| <= v_max``.  With a ``route``, the self-propulsion steers to a goal ``g`` instead, as
+SwarmLab's goal mode does (github:lis-epfl/swarmlab, ``compute_vel_vasarhelyi.m``): the route's point
+where a reference flying it at ``route_speed`` is (:func:`tmem.terms.flocking.leader`; a fixed goal for a
+route of one point).  ``r_ij = |q_j - q_i| < R_C`` (the communication range),
 ``v_ij = |v_j - v_i|``, ``v_ij^max = max(v_frict, D(r_ij - r0_frict, a_frict, p_frict))`` with the
 braking curve D (:func:`tmem.terms.flocking.braking`).  A shill agent ``s`` sits at the point of a
 wall or obstacle nearest agent ``i``, moving at ``v_shill`` along the surface's normal towards the
@@ -32,8 +35,8 @@ from typing import Annotated, NamedTuple
 import numpy as np
 from pydantic import Field
 
-from tmem.scenario.fields import FieldError, NonNegative, Positive, StrictModel
-from tmem.terms.base import AgentTerm, acceleration_per_input, check_gathered_knowledge, surroundings
+from tmem.scenario.fields import FieldError, NonNegative, Number, Positive, StrictModel
+from tmem.terms.base import AgentTerm, acceleration_per_input, check_gathered_knowledge, check_route, surroundings
 
 
 class VasarhelyiParams(StrictModel):
@@ -59,7 +62,9 @@ class VasarhelyiParams(StrictModel):
     * ``a_shill`` 2.5: Acc_Shill = 250 (SwarmLab 3.02);
     * ``tau`` 1.0: tau_PID_XY, the velocity loop's relaxation time (SwarmLab has none);
     * ``a_max`` 6.0: a_max = 600 (SwarmLab max_a = 10);
-    * ``r_c`` 100.0: R_C = 10000, the communication range (SwarmLab r = 150).
+    * ``r_c`` 100.0: R_C = 10000, the communication range (SwarmLab r = 150);
+    * ``route`` (m), ``route_speed`` (m/s): the goal the self-propulsion steers to, flying the route's
+      points from the first at that speed (none by default: self-propulsion along the agent's velocity).
 
     ``c_frict`` is at most 1: more would ask for more than the velocity difference it corrects.
     """
@@ -80,6 +85,8 @@ class VasarhelyiParams(StrictModel):
     tau: Positive = 1.0
     a_max: Positive = 6.0
     r_c: Positive = 100.0
+    route: list[list[Number]] | None = None
+    route_speed: Positive | None = None
 
     def check(self, scenario) -> None:
         """Check the table against the scenario: ``v_flock <= v_max``, ``r0_rep < r_c``, ``tau >= dt``, and no
@@ -100,12 +107,14 @@ class VasarhelyiParams(StrictModel):
         if self.tau < dt:
             raise FieldError("vasarhelyi.tau", f"{self.tau:g} s is shorter than the step dt = {dt:g} s: the velocity loop "
                              "a = (v_d - v) / tau, held over a step, would overshoot v_d (dt / tau > 1)")  # fmt: skip
+        check_route("vasarhelyi", self.route, self.route_speed, scenario.space.axes)
         check_gathered_knowledge(scenario, "vasarhelyi")
 
 
 class VasarhelyiRecord(NamedTuple):
     """The record of the law: the keys of :class:`VasarhelyiParams`; ``walls`` and ``obstacles``
-    (:func:`tmem.terms.base.surroundings`); ``per_input``, the set-point per m/s^2; ``c_max``; and
+    (:func:`tmem.terms.base.surroundings`); the goal's ``route``, ``lengths`` and ``route_speed`` (``goal``:
+    whether there is one), ``dt``; ``per_input``, the set-point per m/s^2; ``c_max``; and
     ``work``, shape (agents, 2, axes): ``v_d`` (then ``a_d``) of agent ``i``, and a shill agent's normal."""
 
     v_flock: float
@@ -124,6 +133,11 @@ class VasarhelyiRecord(NamedTuple):
     tau: float
     a_max: float
     r_c: float
+    goal: bool
+    route: np.ndarray
+    lengths: np.ndarray
+    route_speed: float
+    dt: float
     walls: np.ndarray
     obstacles: np.ndarray
     per_input: float
@@ -140,6 +154,13 @@ def _push(i, k, known, agents, box, law):
         speed2 += known[i, a, 1] * known[i, a, 1]
     for a in range(n_axes):  # self-propulsion along the agent's own velocity
         v[i, 0, a] = law.v_flock * known[i, a, 1] / np.sqrt(speed2) if speed2 > 0.0 else 0.0
+    if law.goal:  # or to the goal
+        gap2 = 0.0
+        for a in range(n_axes):
+            v[i, 0, a] = leader(k * law.dt, law.route, law.lengths, law.route_speed, a)[0] - known[i, a, 0]  # noqa: F821
+            gap2 += v[i, 0, a] * v[i, 0, a]
+        for a in range(n_axes):
+            v[i, 0, a] *= law.v_flock / np.sqrt(gap2) if gap2 > 0.0 else 0.0
     for j in range(known.shape[0]):
         if j != i and agents.active[j]:
             _neighbour(i, j, known, box, law)
@@ -234,10 +255,16 @@ class Vasarhelyi(AgentTerm):
         gains : ndarray
             ``K`` of the law (unused).
         """
+        from tmem.terms.flocking import route_record
+
         walls, obstacles = surroundings(scenario)
-        return VasarhelyiRecord(**settings.model_dump(), walls=walls, obstacles=obstacles,
-                                per_input=1.0 / acceleration_per_input(scenario), c_max=float(scenario.interaction.c_max),
-                                work=np.zeros((scenario.n_agents, 2, scenario.space.axes)))  # fmt: skip
+        axes = scenario.space.axes
+        route, lengths = route_record(settings.route or [[0.0] * axes], axes)
+        keys = settings.model_dump(exclude={"route", "route_speed"})
+        return VasarhelyiRecord(**keys, goal=settings.route is not None, route=route, lengths=lengths,
+                                route_speed=float(settings.route_speed or 0.0), dt=scenario.simulation.dt, walls=walls,
+                                obstacles=obstacles, per_input=1.0 / acceleration_per_input(scenario),
+                                c_max=float(scenario.interaction.c_max), work=np.zeros((scenario.n_agents, 2, axes)))  # fmt: skip
 
     @classmethod
     @cache

@@ -148,6 +148,29 @@ def _near_obstacle(positions: np.ndarray, obstacles, reach: float) -> np.ndarray
     return near
 
 
+def formation_positions(scenario: Scenario) -> np.ndarray:
+    """Where the agents of a generated ``[formation]`` start (m, shape (agents, axes)): their places in the
+    shape about its ``center``, moved by the ``jitter``, or ``scatter``-ed with each at the start CAPT gives it.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Its ``[formation]``.
+    """
+    f, n, axes = scenario.formation, scenario.n_agents, scenario.space.axes
+    shape = generate(f.kind, n, scenario.interaction.d_t if f.d_t is None else f.d_t, axes)
+    rng = np.random.default_rng(f.seed)
+    positions = shape.positions + _vector(f.center or 0.0, axes)
+    positions += rng.uniform(-f.jitter, f.jitter, (n, axes)) if f.jitter > 0 else 0.0
+    return _scattered(positions, f, axes) if f.scatter is not None else positions
+
+
+def _in_first_shape(scenario: Scenario, edges: np.ndarray) -> np.ndarray:
+    """Whether each of ``edges`` is a pair of the formation's own shape, where a mission changes it."""
+    first = {tuple(edge) for edge in generate(scenario.formation.kind, scenario.n_agents, 1.0, scenario.space.axes).edges.tolist()}
+    return np.array([tuple(edge) in first for edge in edges.tolist()], dtype=bool)
+
+
 def build(scenario: Scenario) -> InitialArrays:
     """The initial arrays of ``scenario``.
 
@@ -165,15 +188,11 @@ def build(scenario: Scenario) -> InitialArrays:
     if scenario.swarm is not None:
         state = _random_swarm(scenario, axes)
     elif f is not None and f.kind != "edges":
-        shape = generate(f.kind, n, d_t, axes, f.bearing)
-        rng = np.random.default_rng(f.seed)
         state = np.zeros((n, axes, 4))
-        state[:, :, 0] = shape.positions + _vector(f.center or 0.0, axes)
-        state[:, :, 0] += rng.uniform(-f.jitter, f.jitter, (n, axes)) if f.jitter > 0 else 0.0
-        if f.scatter is not None:
-            state[:, :, 0] = _scattered(state[:, :, 0], f, axes)
+        state[:, :, 0] = formation_positions(scenario)
         state[:, :, 1] = _vector(f.velocity or 0.0, axes)
-        direction = shape.direction
+        shape = generate(f.kind, n, d_t, axes, f.bearing)
+        direction = None if scenario.reshapes else shape.direction  # a reshape sets its pairs' own (tmem.engine.stages)
     else:
         state, active = _listed_agents(scenario, axes)
 
@@ -188,6 +207,8 @@ def build(scenario: Scenario) -> InitialArrays:
             delta = state[edges[:, 1], :, 0] - state[edges[:, 0], :, 0]
             direction = delta / np.linalg.norm(delta, axis=1, keepdims=True)
     flag = np.full(len(edges), 1 if f is not None and f.coupled else 0, dtype=np.int64)
+    if scenario.reshapes:  # coupled: the pairs of the first shape only (tmem.terms.navigation_plan.shapes_flown)
+        flag = (flag & _in_first_shape(scenario, edges)).astype(np.int64)
     box = np.asarray(scenario.space.box, dtype=float) if scenario.space.periodic else np.zeros(axes)
     if scenario.space.periodic:
         state[:, :, 0] %= box
