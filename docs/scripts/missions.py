@@ -137,10 +137,10 @@ def _reshaped(scenario) -> dict:
 def reshape() -> None:
     """The hex flying east turns into a line and back: (2) exactly known, and with sensing at 100 Hz, 0.1 m of noise."""
     base = tmem.load(EXAMPLES / "hex19_reshape.toml")
-    noisy = {"sensing": {"period": 0.01, "position_noise": 0.1, "own_position_noise": 0.1}}
+    noisy = {"period": 0.01, "position_noise": 0.1, "own_position_noise": 0.1}
     exact = [_reshaped(base)]
     with ProcessPoolExecutor(max_workers=2) as pool:
-        sensed = list(pool.map(_reshaped, [with_changes(base, {**noisy, "sensing.seed": seed}) for seed in SEEDS]))
+        sensed = list(pool.map(_reshaped, [with_changes(base, {"sensing": {**noisy, "seed": seed}}) for seed in SEEDS]))
     print("| knowledge | shape | lines' span T (s) | every edge within 0.1 m of d_t from (s after the leg starts) | largest edge error at the shape's end (m) "
           "| largest direction error then (deg) | near misses at 3 m (whole run) | smallest separation (m) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
