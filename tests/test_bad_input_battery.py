@@ -85,7 +85,7 @@ def dump(data: dict) -> str:
 
 
 def changed(base: dict, path: str, value) -> dict:
-    """A deep copy of ``base`` with ``path`` (``table.key``, ``agents.0.velocity``) set; ``DELETE`` removes it."""
+    """A deep copy of ``base`` with ``path`` (``table.key``, ``agents.0.velocity``) set."""
     data = json.loads(json.dumps(base))
     parts = [int(p) if p.isdigit() else p for p in path.split(".")]
     node = data
@@ -167,6 +167,15 @@ case("navigation.legs.0.target wrong size", changed(MISSION, "navigation.legs.0.
 case("navigation.legs.0.action typo", changed(MISSION, "navigation.legs.0.action", "goto!"), "navigation.legs[0].action")
 case("formation.min_spacing without scatter", changed(MISSION, "formation.min_spacing", 30.0), "min_spacing")
 case("swarm.min_spacing too wide", changed(SWARM, "swarm.min_spacing", 150.0), "swarm.min_spacing")
+RESHAPE = changed(MISSION, "navigation.legs", [{"time": 0.0, "action": "hold"},
+                                               {"time": 1.0, "action": "reshape", "shape": "chain", "speed": 2.0}])  # fmt: skip
+case("navigation.legs.1.shape unknown", changed(RESHAPE, "navigation.legs.1.shape", "star"), "navigation.legs[1].shape")
+case("navigation.legs.1.shape missing", changed(RESHAPE, "navigation.legs.1", {"time": 1.0, "action": "reshape", "speed": 2.0}),
+     "navigation.legs[1].shape")
+case("navigation.legs.1.shape too small", changed(RESHAPE, "navigation.legs.1.shape", "triangle"), "navigation.legs[1].shape")
+case("navigation.legs.1.speed list", changed(RESHAPE, "navigation.legs.1.speed", [1.0, 2.0]), "navigation.legs[1].speed")
+case("navigation.legs.1.speed negative", changed(RESHAPE, "navigation.legs.1.speed", -1.0), "navigation.legs[1].speed")
+case("navigation.legs.0.shape unused", changed(RESHAPE, "navigation.legs.0.shape", "ring"), "navigation.legs[0].shape")
 
 # -- every table x {not a table, an unknown key} -------------------------------------------------------
 

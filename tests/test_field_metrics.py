@@ -262,6 +262,22 @@ def test_edge_errors_against_loops():
     np.testing.assert_allclose(fm.edge_errors(positions, edges, d_t), expected, rtol=1e-12)
 
 
+def test_the_summary_takes_only_the_edges_held_at_each_record():
+    """A formation that changes its shape: the edges it does not hold at a record are left out of the errors."""
+    positions, velocities, _ = random_case(0)
+    times = np.arange(len(positions), dtype=float)
+    edges, d_t = np.array([[0, 1], [2, 5], [6, 3]]), np.array([1.0, 0.5, 2.0])
+    members = np.random.default_rng(1).random((len(times), len(edges))) < 0.5
+    members[-1] = [False, True, False]
+    held = [abs(math.dist(x[i], x[j]) - d) for x, row in zip(positions, members) for (i, j), d, m in zip(edges, d_t, row) if m]
+    figures = fm.field_summary(positions, velocities, times, edges=edges, d_t=d_t, members=members)
+    assert figures["edge_error_max"] == pytest.approx(max(held), rel=1e-12)
+    assert figures["edge_error_rms"] == pytest.approx(math.sqrt(sum(e * e for e in held) / len(held)), rel=1e-12)
+    assert figures["edge_error_max_final"] == pytest.approx(abs(math.dist(positions[-1][2], positions[-1][5]) - 0.5), rel=1e-12)
+    everything = fm.field_summary(positions, velocities, times, edges=edges, d_t=d_t)
+    assert everything["edge_error_max"] > figures["edge_error_max"]  # the mask left something out: the test could fail
+
+
 def rotation_2d(angle: float) -> np.ndarray:
     return np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
 

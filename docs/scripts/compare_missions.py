@@ -3,7 +3,7 @@
 Prints Markdown tables to standard output, each cell the median / worst over 20 seeds::
 
     python docs/scripts/compare_missions.py              # every task, about 15 minutes on 2 cores
-    python docs/scripts/compare_missions.py route        # the hex's 1 km route (starts jittered by up to 2 m)
+    python docs/scripts/compare_missions.py route        # the hex's 1 km route (starts jittered by up to 1 m)
     python docs/scripts/compare_missions.py obstacles    # 20 random fields of 10 obstacles
     python docs/scripts/compare_missions.py assembly     # 19 agents from 20 random starts
 
@@ -104,12 +104,12 @@ def _table(jobs_per_law: list[list], obstacles: bool) -> None:
 
 
 def route() -> None:
-    """The hex's 1 km route with three turns at 5 m/s, its starts jittered by up to 2 m (seeds 1-20), 400 s."""
+    """The hex's 1 km route with three turns at 5 m/s, its starts jittered by up to 1 m (seeds 1-20), 400 s."""
     base = tmem.load(EXAMPLES / "hex19_route.toml")
     waypoints = [list(w) for w in base.navigation.legs[0].waypoints]
-    jobs = [[(_scenarios(with_changes(base, {"formation.jitter": 2.0, "formation.seed": seed}), law, [[0.0, 0.0], *waypoints], 400.0),
+    jobs = [[(_scenarios(with_changes(base, {"formation.jitter": 1.0, "formation.seed": seed}), law, [[0.0, 0.0], *waypoints], 400.0),
               waypoints[-1]) for seed in SEEDS] for law in range(3)]  # fmt: skip
-    print(f"Starts jittered by up to 2 m, seeds {SEEDS.start}-{SEEDS.stop - 1}; each cell: median / worst.\n")
+    print(f"Starts jittered by up to 1 m, seeds {SEEDS.start}-{SEEDS.stop - 1}; each cell: median / worst.\n")
     _table(jobs, obstacles=False)
 
 

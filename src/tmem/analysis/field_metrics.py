@@ -23,8 +23,8 @@ value undefined:
 * ``min_obstacle_clearance`` and ``min_wall_clearance`` (m): the least :func:`obstacle_clearance` and
   :func:`wall_clearance`.  ``shape_distance_final`` (m): :func:`shape_distance` at the last record.
 * ``edge_error_max`` and ``edge_error_rms`` (m): the largest ``|e|`` and the RMS of :func:`edge_errors`
-  over every record and edge; ``edge_error_max_final`` and ``edge_error_rms_final`` (m): at the last.
-* ``time_to_goal`` (s): :func:`time_to_goal`.
+  over every record and edge the formation holds then (``members``; every edge by default);
+  ``edge_error_max_final`` and ``edge_error_rms_final`` (m): at the last.  ``time_to_goal`` (s): :func:`time_to_goal`.
 """
 
 from __future__ import annotations
@@ -363,9 +363,7 @@ def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarr
     Parameters
     ----------
     positions, velocities, times, active : the recorded arrays (module docstring); edges and shape take every agent
-    edges, d_t : :func:`edge_errors`'s, optional
-    members : ndarray (records, edges), bool, optional
-        Which edges the formation holds at each record (a mission that changes its shape); the others are left out
+    edges, d_t : :func:`edge_errors`'s, optional; members : ndarray (records, edges), bool, optional (module text)
     target : :func:`shape_distance`'s, optional
     obstacles : (centers, radii), :func:`obstacle_clearance`'s, optional
     box : :func:`wall_clearance`'s, optional
@@ -382,8 +380,7 @@ def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarr
     share = found.get("pairs_within_share", ())
     wide = communication_range is None or flying.sum(axis=1).max() > MAX_CONNECTIVITY_AGENTS
     errors = np.abs(edge_errors(p, edges, d_t)) if edges is not None else np.zeros((1, 0))
-    if members is not None:
-        errors = np.where(members, errors, np.nan)
+    errors = errors if members is None else np.where(members, errors, np.nan)
     return {
         "order_mean": _reduce(phi[times >= (times[0] + times[-1]) / 2], np.mean), "order_min": _reduce(phi),
         "min_separation": min_separation(p, flying), "near_misses": found.get("count"),
