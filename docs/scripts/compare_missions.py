@@ -2,7 +2,7 @@
 
 Prints Markdown tables to standard output, each cell the median / worst over 20 seeds::
 
-    python docs/scripts/compare_missions.py              # every task, about 15 minutes on 2 cores
+    python docs/scripts/compare_missions.py              # every task, about 17 minutes on 2 cores
     python docs/scripts/compare_missions.py route        # the hex's 1 km route (starts jittered by up to 1 m)
     python docs/scripts/compare_missions.py obstacles    # 20 random fields of 10 obstacles
     python docs/scripts/compare_missions.py assembly     # 19 agents from 20 random starts
@@ -17,8 +17,10 @@ for the obstacle field, the route TMEM's mission plans round it (N4) (their own 
 agents keep them off the obstacles); for the assembly, fixed at the shape's centre.
 
 Every figure is computed the same way for every law, from the recorded states: near misses at 3 m
-(once per encounter) and the least separation; groups at most at once and order (second half) at the
-communication range of 100 m (robotsim's), and the groups at the end; the least clearance to an obstacle; the time the group's
+(once per encounter) and the least separation; groups at most at once at the
+communication range of 100 m (robotsim's), and the groups at the end; the order (velocity
+correlation) from 20 s until the reference arrives (none for the assembly, whose agents end at
+rest); the least clearance to an obstacle; the time the group's
 centre comes within 2 m of the goal and stays; and the spacing error at the end, the largest
 |d_nn - 35 m| of an agent's nearest neighbour (0 for a perfect hex or α-lattice at 35 m).
 """
@@ -32,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 import tmem
-from tmem.analysis.field_metrics import time_to_goal, union
+from tmem.analysis.field_metrics import order, time_to_goal, union
 from tmem.analysis.metrics import summarize
 from tmem.scenario import with_changes
 
@@ -68,7 +70,7 @@ def _scenarios(base, law: int, route: list, duration: float):
 
 def _measured(job) -> dict:
     """One run's figures (module text)."""
-    scenario, goal = job
+    scenario, goal, flying = job
     trajectory = tmem.simulate(scenario)
     safety = summarize(trajectory)["safety"]
     p = trajectory.model.position(trajectory.state)
@@ -76,19 +78,30 @@ def _measured(job) -> dict:
     reached = time_to_goal(p, trajectory.time, np.asarray(goal, float), 2.0)
     return {"near": safety["near_misses"], "separation": safety["min_separation"], "groups": safety["union_max"],
             "groups_end": int(union(p[-1:], 100.0)[0]),
-            "order": safety["order_mean"], "clearance": safety["min_obstacle_clearance"],
+            "order": _order_while_flying(trajectory, flying), "clearance": safety["min_obstacle_clearance"],
             "goal": np.inf if reached is None else reached, "spacing": float(np.abs(gaps.min(axis=1) - D_T).max())}  # fmt: skip
 
 
+def _order_while_flying(trajectory, flying: float | None) -> float:
+    """The mean order (velocity correlation) from 20 s until the reference arrives at ``flying`` (s); NaN for none."""
+    if flying is None:
+        return float("nan")
+    window = (trajectory.time >= 20.0) & (trajectory.time <= flying)
+    return float(np.nanmean(order(trajectory.model.velocity(trajectory.state)[window])))
+
+
 def _cell(values, form: str, worst=max) -> str:
+    """``median / worst`` of ``values``; a dash where none is measured."""
+    if all(np.isnan(v) for v in values):
+        return "—"
     return f"{form.format(float(np.median(values)))} / {form.format(worst(values))}"
 
 
 def _table(jobs_per_law: list[list], obstacles: bool) -> None:
     with ProcessPoolExecutor(max_workers=2) as pool:
         runs = [list(pool.map(_measured, jobs)) for jobs in jobs_per_law]
-    head = ["law", "near misses at 3 m", "least separation (m)", "most groups", "groups at the end", "order", "time to goal (s)",
-            "spacing error at the end (m)"]
+    head = ["law", "near misses at 3 m", "least separation (m)", "most groups", "groups at the end", "order while flying",
+            "time to goal (s)", "spacing error at the end (m)"]
     head += ["breaches", "least obstacle clearance (m)"] if obstacles else []
     print("| " + " | ".join(head) + " |")
     print("|" + " --- |" * len(head))
@@ -107,8 +120,10 @@ def route() -> None:
     """The hex's 1 km route with three turns at 5 m/s, its starts jittered by up to 1 m (seeds 1-20), 400 s."""
     base = tmem.load(EXAMPLES / "hex19_route.toml")
     waypoints = [list(w) for w in base.navigation.legs[0].waypoints]
-    jobs = [[(_scenarios(with_changes(base, {"formation.jitter": 1.0, "formation.seed": seed}), law, [[0.0, 0.0], *waypoints], 400.0),
-              waypoints[-1]) for seed in SEEDS] for law in range(3)]  # fmt: skip
+    route = [[0.0, 0.0], *waypoints]
+    flying = float(np.sum(np.linalg.norm(np.diff(route, axis=0), axis=1))) / SPEED
+    jobs = [[(_scenarios(with_changes(base, {"formation.jitter": 1.0, "formation.seed": seed}), law, route, 400.0),
+              waypoints[-1], flying) for seed in SEEDS] for law in range(3)]  # fmt: skip
     print(f"Starts jittered by up to 1 m, seeds {SEEDS.start}-{SEEDS.stop - 1}; each cell: median / worst.\n")
     _table(jobs, obstacles=False)
 
@@ -125,8 +140,9 @@ def obstacles() -> None:
         centres, radii = random_discs(10, [300.0, -150.0], [1300.0, 150.0], (20.0, 60.0), gap=10.0, seed=seed)
         field = with_changes(base, {"obstacles": [{"center": c.tolist(), "radius": float(r)} for c, r in zip(centres, radii)]})
         planned = [[0.0, 0.0], *planned_points(field)[0][2].tolist()]  # TMEM's route round the field (N4)
+        flying = float(np.sum(np.linalg.norm(np.diff(planned, axis=0), axis=1))) / SPEED
         for law in range(3):
-            jobs[law].append((_scenarios(field, law, planned, 600.0), goal))
+            jobs[law].append((_scenarios(field, law, planned, 600.0), goal, flying))
     print(f"Fields of seeds {SEEDS.start}-{SEEDS.stop - 1}; each cell: median / worst.\n")
     _table(jobs, obstacles=True)
 
@@ -135,7 +151,7 @@ def assembly() -> None:
     """19 agents at rest from random starts in a 500 m square (seeds 1-20) to the hex at the origin, 400 s."""
     base = tmem.load(EXAMPLES / "hex19_assemble.toml")
     centre = list(base.formation.center)
-    jobs = [[(_scenarios(with_changes(base, {"formation.seed": seed}), law, [centre], 400.0), centre) for seed in SEEDS]
+    jobs = [[(_scenarios(with_changes(base, {"formation.seed": seed}), law, [centre], 400.0), centre, None) for seed in SEEDS]
             for law in range(3)]  # fmt: skip
     print(f"Starts of seeds {SEEDS.start}-{SEEDS.stop - 1}; each cell: median / worst.\n")
     _table(jobs, obstacles=False)
