@@ -35,10 +35,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-__all__ = [
-    "order", "separations", "min_separation", "near_misses", "collisions", "union", "algebraic_connectivity",
-    "obstacle_clearance", "wall_clearance", "edge_errors", "shape_distance", "time_to_goal", "field_summary",
-]  # fmt: skip
+__all__ = ["order", "separations", "min_separation", "near_misses", "collisions", "union", "algebraic_connectivity",
+           "obstacle_clearance", "wall_clearance", "edge_errors", "shape_distance", "time_to_goal", "field_summary"]  # fmt: skip
 
 #: The most active agents :func:`algebraic_connectivity` takes (a dense eigenvalue problem a record).
 MAX_CONNECTIVITY_AGENTS = 2000
@@ -363,7 +361,8 @@ def field_summary(positions: np.ndarray, velocities: np.ndarray, times: np.ndarr
     Parameters
     ----------
     positions, velocities, times, active : the recorded arrays (module docstring); edges and shape take every agent
-    edges, d_t : :func:`edge_errors`'s, optional; members : ndarray (records, edges), bool, optional (module text)
+    edges, d_t : :func:`edge_errors`'s, optional
+    members : ndarray (records, edges), bool, optional: the edges held at each record (module text)
     target : :func:`shape_distance`'s, optional
     obstacles : (centers, radii), :func:`obstacle_clearance`'s, optional
     box : :func:`wall_clearance`'s, optional
