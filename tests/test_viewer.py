@@ -168,7 +168,7 @@ def test_reading_a_block_of_agents_at_a_time_reads_the_same(tmp_path, monkeypatc
     whole = read_view(run, max_agents=5, max_frames=20)
     monkeypatch.setattr(data, "_READ_VALUES", 9)  # an agent's record per block
     blocks = read_view(run, max_agents=5, max_frames=20)
-    for name in ("time", "position", "speed", "status", "strain", "coupled", "rms", "pair_distance"):
+    for name in ("time", "position", "speed", "status", "strain", "coupled", "drawn", "rms", "pair_distance"):
         np.testing.assert_array_equal(getattr(blocks, name), getattr(whole, name), err_msg=name)
     every = read_view(run, max_frames=50)  # every agent: read in slices
     monkeypatch.setattr(data, "_READ_VALUES", 10**9)
@@ -400,3 +400,27 @@ def test_the_headline_shows_the_safety_figures_given():
     assert cleared["min obstacle clearance"] == "0.50 m" and cleared["near misses"] == "3"
     assert "near misses" in dict(headline({"safety": {"near_misses": 0}}))
     assert len(headline({"safety": None})) == len(headline({})) == 6
+
+
+def test_a_reshaping_formation_draws_only_the_pairs_of_the_shape_it_flies(tmp_path):
+    """While the lines fly, no pair is drawn; after them, the drawn edges are the pairs found d_t apart."""
+    import sys
+
+    import tmem
+    from tmem.analysis.metrics import summarize
+    from tmem.files.io import write_netcdf
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_reshape import RESHAPE
+
+    trajectory = tmem.simulate(tmem.loads(RESHAPE))
+    write_netcdf(trajectory, tmp_path / "trajectory.nc")
+    (tmp_path / "summary.json").write_text(json.dumps(summarize(trajectory)))
+    view = read_view(tmp_path, max_frames=len(trajectory.time))
+    during, after = (np.searchsorted(view.time, t) for t in (60.0, 160.0))  # lines 40-81.4 s, then the line
+    assert not view.drawn[during].any() and view.drawn[0].sum() == 12
+    agents = view.agents - 1
+    p = view.position[after]
+    apart = {tuple(sorted((int(agents[a]), int(agents[b])))) for a, b in view.edges if abs(np.linalg.norm(p[b] - p[a]) - 35.0) < 0.1}
+    drawn = {tuple(sorted((int(agents[a]), int(agents[b])))) for a, b in view.edges[view.drawn[after]]}
+    assert len(drawn) == 6 and drawn == apart

@@ -75,6 +75,9 @@ class View:
         ``(|P_j - P_i| - d_t) / d_t`` of each edge.
     coupled : ndarray of bool, shape (F, E)
         ``F_en = 1``.
+    drawn : ndarray of bool, shape (F, E)
+        Whether the edge is drawn: always, but where a mission changes the formation's shape, only the
+        pairs of the shape flown then (:func:`tmem.terms.navigation_plan.held_pairs`).
     strain_scale : float
         The end of the symmetric colour scale of strain, fitted to the run (:func:`strain_scale`).
     rms : ndarray, shape (F,)
@@ -106,6 +109,7 @@ class View:
     edges: np.ndarray
     strain: np.ndarray
     coupled: np.ndarray
+    drawn: np.ndarray
     strain_scale: float
     rms: np.ndarray
     pair_labels: list[str]
@@ -212,6 +216,12 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
         edges, edge_pairs = _edges(ids[agents], pairs)
         strain = distance[:, edge_pairs] / d_t[edge_pairs] - 1.0
         coupled = at_frames("F_en")[:, edge_pairs] == 1
+        time = at_frames("time").astype(float)
+        drawn = np.ones_like(coupled)
+        if scenario.formation is not None and scenario.shapes_change:
+            from tmem.terms.navigation_plan import held_pairs
+
+            drawn = held_pairs(scenario, pairs, time)[0][:, edge_pairs]
         pair_labels, pair_distance = _pair_series(distance, pairs)
         view = View(
             name=scenario.name,
@@ -220,13 +230,14 @@ def _read(path: Path, max_agents: int, max_frames: int | None) -> View:
             reach=scenario.interaction.reach,
             space=_space(scenario),
             agents=ids[agents] + 1,
-            time=at_frames("time").astype(float),
+            time=time,
             position=position,
             speed=speed,
             status=status,
             edges=edges,
             strain=strain,
             coupled=coupled,
+            drawn=drawn,
             strain_scale=strain_scale(strain, coupled, status, edges),
             rms=at_frames("rms_velocity").astype(float),
             pair_labels=pair_labels,

@@ -156,6 +156,7 @@ def page_data(view: View) -> dict:
         "edges": view.edges.reshape(-1).tolist(),
         "strain": _b64(view.strain, "<f4"),
         "coupled": _b64(view.coupled, "u1"),
+        "drawn": _b64(view.drawn, "u1"),
         "strainScale": view.strain_scale,
         "rms": _b64(view.rms, "<f4"),
         "pairLabels": view.pair_labels,

@@ -34,6 +34,7 @@ export function decode(text) {
     status: bytes(d.status),
     strain: f32(d.strain),
     coupled: bytes(d.coupled),
+    drawn: bytes(d.drawn),
     rms: f32(d.rms),
     pairDistance: f32(d.pairDistance),
   };

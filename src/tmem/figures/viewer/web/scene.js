@@ -240,7 +240,7 @@ export class Scene {
   }
 
   #edges(f) {
-    const { A, E, edges, status, strain, coupled, strainScale, space } = this.run;
+    const { A, E, edges, status, strain, coupled, drawn, strainScale, space } = this.run;
     const objects = [this.coupledEdges, this.looseEdges];
     const counts = [0, 0];
     const p = new THREE.Vector3(), q = new THREE.Vector3(), colour = new THREE.Color();
@@ -248,7 +248,7 @@ export class Scene {
     const below = this.run.D === 3 ? 0 : 0.1; // in the plane, edges under the agents
     for (let e = 0; e < E; e++) {
       const [i, j] = [edges[2 * e], edges[2 * e + 1]];
-      if (status[f * A + i] !== FLYING || status[f * A + j] !== FLYING) continue;
+      if (status[f * A + i] !== FLYING || status[f * A + j] !== FLYING || !drawn[f * E + e]) continue;
       this.at(f, i, p);
       this.at(f, j, q);
       if (half && (Math.abs(p.x - q.x) > half.x || Math.abs(p.y - q.y) > half.y || Math.abs(p.z - q.z) > half.z)) continue;
