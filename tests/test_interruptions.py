@@ -64,6 +64,14 @@ def partials(folder: Path, name: str) -> list[str]:
     return sorted(n for n in os.listdir(folder) if n.startswith(f".{name}."))
 
 
+def being_written(folder: Path, name: str) -> bool:
+    """Whether a temporary output named after ``name`` is being written: its directory locked and renamed to
+    its partial name.  A kill in the microseconds before (``.NAME.tmem-starting-*`` made, its lock file not
+    yet written) leaves that directory, which no later command can tell from one being made
+    (:mod:`tmem.files.outputs.names`): the tests kill while the output is written."""
+    return any(".tmem-partial-" in n for n in partials(folder, name))
+
+
 class Command:
     """``python -m tmem ARGS`` in a session of its own, its output on a pseudo-terminal (progress bars show).
 
@@ -180,7 +188,7 @@ def test_interrupted_run_leaves_the_earlier_output_or_a_whole_new_one(long_run, 
     shutil.copytree(previous, out)
     before = snapshot(out)
     command = Command("run", scenario, "--out", out, cwd=tmp_path)
-    reached = moment(command, when, lambda: bool(partials(tmp_path, "out")))
+    reached = moment(command, when, lambda: being_written(tmp_path, "out"))
     if reached:
         command.send(signum)
     code, output = command.finish()
@@ -233,7 +241,7 @@ def test_interrupted_animate_leaves_no_partial_gif(run_2d, tmp_path, name, when)
     shutil.copytree(run_2d, run)
     gif = tmp_path / "run.gif"  # beside the run, by default
     command = Command("animate", run, "--max-frames", "40", cwd=tmp_path)
-    reached = moment(command, when, lambda: bool(partials(tmp_path, "run.gif")) or gif.exists())
+    reached = moment(command, when, lambda: being_written(tmp_path, "run.gif") or gif.exists())
     if reached:
         command.send(signum)
     code, output = command.finish()
@@ -295,7 +303,7 @@ def test_interrupted_plot_leaves_the_old_figures_or_whole_new_ones(run_2d, tmp_p
     figures = sorted(p.name for p in run.glob("*.png"))
     before = {figure: (run / figure).read_bytes() for figure in figures}  # tmem's own: plot may replace them
     command = Command("plot", run, cwd=tmp_path)
-    reached = moment(command, "writing", lambda: bool(partials(run, "figures")))
+    reached = moment(command, "writing", lambda: being_written(run, "figures"))
     if reached:
         command.send(signum)
     code, output = command.finish()
