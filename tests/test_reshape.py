@@ -155,6 +155,7 @@ def test_a_reshape_goes_on_from_its_checkpoint_to_the_same_bits(tmp_path):
     ({"navigation.legs[1].speed": [4.0, 5.0]}, r"navigation\.legs\[1\]\.speed: is one speed for reshape"),
     ({"navigation.legs[0]": {"time": 0.0, "action": "hold", "shape": "ring"}}, r"navigation\.legs\[0\]\.shape: is not used by hold"),
     ({"formation": None, "swarm": {"n": 7, "region": [300.0, 300.0], "seed": 1}}, r"navigation\.legs\[1\]\.action: 'reshape' needs a \[formation\] of a generated kind"),
+    ({"navigation.legs[2].time": 60.0}, r"navigation\.legs\[2\]\.time: 60 s is before the reshape of legs\[1\] ends its lines at 81\.4 s"),
     ({"navigation.legs[2]": {"time": 170.0, "action": "assemble", "speed": 4.0}},
      r"navigation\.legs\[2\]\.action: an assemble leg comes before any reshape"),
 ])  # fmt: skip

@@ -142,6 +142,16 @@ class NavigationParams(StrictModel):
             from tmem.terms.navigation_plan import planned_points
 
             planned_points(scenario)  # refuses a route that cannot clear the obstacles (N4)
+        shaping = [k for k, leg in enumerate(self.legs[:-1]) if leg.action in ("assemble", "reshape")]
+        if shaping:  # the next leg waits for the lines' end, where the shape's pairs couple
+            from tmem.terms.navigation_plan import shapes_flown
+
+            ends = {shape.leg: self.legs[shape.leg].time + shape.span for shape in shapes_flown(scenario)[1:]}
+            for k in shaping:
+                if self.legs[k + 1].time < ends[k]:
+                    raise FieldError(f"navigation.legs[{k + 1}].time", f"{self.legs[k + 1].time:g} s is before the "
+                                     f"{self.legs[k].action} of legs[{k}] ends its lines at {ends[k]:.4g} s, where the "
+                                     "shape's pairs couple: start it then or later")  # fmt: skip
 
     @staticmethod
     def _check_shaping(k: int, leg: Leg, scenario) -> None:
