@@ -16,6 +16,7 @@ keeps that one.
 """
 
 import gc
+import os
 import signal
 from fnmatch import fnmatch
 
@@ -26,6 +27,11 @@ import pytest
 # they should, leave it ignored: take Python's own handler back, so that they start with the default.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+# A run says on standard error when its step loop compiles (tmem.engine.driver.COMPILING), whichever test
+# comes first to a kind of run: the tests of what commands write there would depend on their order.
+# They run without it (inherited by the commands they start); tests/test_compile_notice.py turns it on.
+os.environ["TMEM_NO_COMPILE_NOTICE"] = "1"
 
 KINDS = ("unit", "physics", "pins", "interface")
 
@@ -42,7 +48,7 @@ MODULE_KINDS = {
     ],
     "pins": ["test_pins"],
     "interface": [
-        "test_animate", "test_api_inputs", "test_bad_*", "test_cli_help", "test_crazyflies", "test_docs_text", "test_docstrings",
+        "test_animate", "test_api_inputs", "test_bad_*", "test_cli_help", "test_compile_notice", "test_crazyflies", "test_docs_text", "test_docstrings",
         "test_examples", "test_exchange", "test_exchange_cf", "test_extensions", "test_figures", "test_interruptions",
         "test_light_imports", "test_literal_text", "test_output_directories", "test_outputs", "test_plot_command",
         "test_sweep_failures", "test_sweep_run", "test_sweep_spec", "test_trajectory_file", "test_vehicle_sweeps",

@@ -15,6 +15,7 @@ agents.
 from __future__ import annotations
 
 import os
+import sys
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -32,7 +33,7 @@ from tmem.scenario.sensing_table import SensingParams, with_overrides
 from tmem.world.sensing import Sensing, exact, sensing_of
 from tmem.engine.checkpoint import Checkpoints, Saved, restore
 from tmem.engine.loop import advance_for
-from tmem.engine.variants import Variant
+from tmem.engine.variants import Variant, compiles
 from tmem.engine.lists import NeighbourLister
 from tmem.engine.gas import SNAPSHOT, TOTALS, gas_record
 from tmem.law.record import law_of
@@ -42,6 +43,12 @@ from tmem.engine.records import (
 from tmem.engine.trajectory import DIVERGED, SimulationError, Trajectory, read_events
 from tmem.terms import term_class
 
+#: The line a run writes to standard error before its step loop compiles: once per kind of run (vehicle,
+#: knowledge, terms, gas, threads) on a machine, then Numba's cache holds it.  The time is what two
+#: shipped examples' first runs spent compiling on 2 cores (23 and 33 s, docs/speed.md).
+COMPILING = "tmem: compiling the step loop for this kind of run ({name}), once on this machine: about 30 s"
+#: An environment variable that, set to 1, leaves the line out (scripts that keep standard error for errors).
+QUIET = "TMEM_NO_COMPILE_NOTICE"
 #: Swarms at least this large step on threads: below, starting the threads at every step costs more
 #: than it saves (gas-N on 2 cores: 1.14e7 agent-steps/s serial against 9.5e6 threaded at 10^3, equal
 #: at 10^4).
@@ -353,12 +360,17 @@ def _drive(advance, run: Run, stages: Stages, swarm: _Slots, lister: NeighbourLi
         lister.builds = resume.list_builds
     counters = swarm.counters
     chunk = 1000
+    first = True
     while counters.step[0] <= run.n_steps:
         started = _time.perf_counter()
         at = checkpoints.due(counters.step[0]) if checkpoints is not None else run.n_steps + 1
         stop = min(counters.step[0] + chunk, run.n_steps + 1, at)
-        status = advance(stop, run, stages.law, stages.params, stages.vehicle, stages.knowledge, swarm.agents, swarm.pairs,
-                         neighbours, swarm.commands, swarm.records, swarm.events, counters, stages.gas, terms)  # fmt: skip
+        args = (stop, run, stages.law, stages.params, stages.vehicle, stages.knowledge, swarm.agents, swarm.pairs,
+                neighbours, swarm.commands, swarm.records, swarm.events, counters, stages.gas, terms)  # fmt: skip
+        if first and os.environ.get(QUIET) != "1" and compiles(advance, args):  # only the first call compiles
+            print(COMPILING.format(name=advance.__name__), file=sys.stderr, flush=True)
+        first = False
+        status = advance(*args)
         if status == LISTS_STALE:
             neighbours = lister.list(swarm.agents.active, run.box)  # and go on from the same step
             continue

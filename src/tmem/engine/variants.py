@@ -120,3 +120,26 @@ def chain(kernels: tuple, start: int = 0):
         return _nothing
     return bound(_first_then_rest, f"term_{start}_of_{len(kernels)}", {"inline": "always"}, first=kernels[start],
                  rest=chain(kernels, start + 1), INDEX=start)  # fmt: skip
+
+
+def compiles(dispatcher, args: tuple) -> bool:
+    """Whether calling the compiled copy ``dispatcher`` with ``args`` compiles it: not compiled in this process,
+    and not in Numba's on-disk cache for these arguments' types (the cache's own index, whose entries go
+    stale with the source).  ``False`` where that cannot be told (the cache's index is not Numba's public
+    API): a notice is then left out rather than given falsely.
+
+    Parameters
+    ----------
+    dispatcher : numba Dispatcher
+        A copy made by :func:`bound` with ``cache=True``.
+    args : tuple
+        The arguments it is about to be called with.
+    """
+    if dispatcher.overloads:
+        return False
+    try:
+        signature = tuple(dispatcher.typeof_pyval(a) for a in args)
+        cache = dispatcher._cache
+        return cache._index_key(signature, dispatcher.targetctx.codegen()) not in cache._cache_file._load_index()
+    except Exception:  # another Numba's cache layout
+        return False
