@@ -310,7 +310,9 @@ def _push(i, k, known, agents, box, nav):
         return
     n_axes = len(box)
     kind = nav.leg_kind[leg]
-    centre(i, known, agents.active, nav.centre)  # noqa: F821  (bound)
+    on_lines = (kind == ASSEMBLE or kind == RESHAPE) and (k - nav.leg_step[leg]) * nav.dt < nav.leg_span[leg]
+    if nav.leg_now[i] != leg or not on_lines:  # on the lines the centre is needed only where they start: O(N) saved
+        centre(i, known, agents.active, nav.centre)  # noqa: F821  (bound)
     if nav.leg_now[i] != leg:  # the leg starts: from here, at its first point
         nav.leg_now[i] = leg
         nav.point_now[i] = nav.leg_first[leg]
@@ -318,7 +320,6 @@ def _push(i, k, known, agents, box, nav):
             nav.leg_from[i, a] = nav.centre[i, a, 0]
             nav.line_from[i, a] = known[i, a, 0]
             nav.drift[i, a] = nav.centre[i, a, 1] if kind == RESHAPE else 0.0
-    on_lines = (kind == ASSEMBLE or kind == RESHAPE) and (k - nav.leg_step[leg]) * nav.dt < nav.leg_span[leg]
     if on_lines:  # its own state, towards its own place
         for a in range(n_axes):
             for s in range(nav.centre.shape[2]):
