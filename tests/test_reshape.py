@@ -162,3 +162,11 @@ def test_a_reshape_goes_on_from_its_checkpoint_to_the_same_bits(tmp_path):
 def test_a_bad_reshape_is_refused_in_one_line_naming_the_key(change, message):
     with pytest.raises(ScenarioError, match=message):
         with_changes(tmem.loads(RESHAPE), change)
+
+
+def test_a_reshapes_speed_is_among_the_speeds_the_vehicles_bounds_check():
+    """The quadrotor's airspeed bound (B3) and (M1) read a mission's speeds: a reshape's is one of them."""
+    from tmem.scenario.motion_bounds import speeds
+
+    found = {s.field: s.velocity for s in speeds(tmem.loads(RESHAPE))}
+    assert found["navigation.legs[1].speed"] == (4.0, 0.0) and found["navigation.legs[2].speed"] == (4.0, 0.0)

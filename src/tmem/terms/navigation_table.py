@@ -51,7 +51,10 @@ class Leg(StrictModel):
         return [] if self.target is None else [list(self.target)]
 
     def speeds(self) -> list[float]:
-        """The speed towards each point (m/s); ``inf`` for ``hold`` (its approach has no cruise)."""
+        """The speed towards each point (m/s); ``inf`` for ``hold`` (its approach has no cruise); an assembly's or
+        a reshape's one speed, every agent's top speed on its line."""
+        if self.action in ("assemble", "reshape"):
+            return [float(self.speed)]
         n = len(self.points())
         if self.speed is None:
             return [np.inf] * n
